@@ -1,0 +1,41 @@
+#pragma once
+// Command-line and TOML options of the line pipeline, shared by every tool and service so a flag
+// means the same everywhere. Values left unset fall back to the defaults for the sensor size.
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "evldt/lines/params.hpp"
+
+namespace evldt {
+
+class PipelineOptions {
+ public:
+  /// Adds --config (TOML, keys = long flag names; unknown keys are an error) and the pipeline flags.
+  void add_to(CLI::App& app);
+
+  /// Sensor size given on the command line or in the config file, if any.
+  [[nodiscard]] std::optional<SensorSize> sensor() const;
+  /// The full configuration for `sensor`: its defaults, then every option that was set.
+  /// Throws std::invalid_argument on a value out of range.
+  [[nodiscard]] PipelineConfig resolve(SensorSize sensor) const;
+  [[nodiscard]] Timestamp time_slack_us() const { return time_slack_us_; }
+
+ private:
+  std::optional<int> width_, height_, block_size_, fit_iterations_, max_bad_tracks_;
+  std::optional<double> alpha_;
+  std::optional<float> fit_threshold_, inlier_ratio_, perturbation_;
+  std::optional<std::string> multi_block_norm_;
+  std::optional<Timestamp> track_period_, detect_period_;
+  Timestamp time_slack_us_ = 1000;
+};
+
+/// CLI11's Range accepts NaN (every comparison with it is false): floating options also need this.
+const CLI::Validator& finite_number();
+
+/// --log-level (trace, debug, info, warn, error, off); apply_log_level also sends logs to stderr.
+void add_log_level_option(CLI::App& app, std::string& level);
+void apply_log_level(const std::string& level);
+
+}  // namespace evldt

@@ -1,0 +1,34 @@
+#pragma once
+// The end-of-run summary of an offline run: what came in, what was dropped, what the pipeline made.
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "evldt/events/event_validator.hpp"
+#include "evldt/lines/deterministic_pipeline.hpp"
+
+namespace evldt {
+
+struct RunSummary {
+  std::string input;
+  std::string input_error;  ///< set when the input ended in a format error
+  std::uint64_t events_read = 0;
+  DropCounts drops;
+  double event_seconds = 0;
+  double wall_seconds = 0;
+  PipelineCounters counters;
+  std::uint64_t lines_created = 0;
+  std::uint64_t lines_alive = 0;
+  std::uint64_t released[kReleaseReasonCount] = {};
+  LifetimeStats lifetimes;  ///< released and live lines
+  std::uint64_t csv_rows = 0;
+  int frames = 0;
+
+  /// Takes line counts and lifetimes (released plus still alive) from the line map.
+  void add_lines(const LineMap& lines);
+  void print(std::FILE* out, const std::string& csv_path) const;
+  void write_json(const std::filesystem::path& path) const;
+};
+
+}  // namespace evldt

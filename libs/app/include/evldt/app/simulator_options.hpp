@@ -1,0 +1,29 @@
+#pragma once
+// Command-line options selecting a built-in simulated scene and its event-camera model, shared by
+// evldt-sim, evldt-offline and evldt-camera.
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "evldt/sim/event_simulator.hpp"
+
+namespace evldt {
+
+class SimulatorOptions {
+ public:
+  /// scene_required: the scene flag must be given (otherwise it selects the simulator as source).
+  void add_to(CLI::App& app, bool scene_required);
+  [[nodiscard]] bool scene_selected() const { return !scene_.empty(); }
+  [[nodiscard]] const std::string& scene_name() const { return scene_; }
+  /// The scene with the duration override applied; throws std::invalid_argument on an unknown name.
+  [[nodiscard]] Scene scene() const;
+  [[nodiscard]] SimulatorConfig config() const { return config_; }
+
+ private:
+  std::string scene_;
+  std::optional<double> duration_s_;
+  SimulatorConfig config_;
+};
+
+}  // namespace evldt

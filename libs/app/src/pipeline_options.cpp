@@ -1,0 +1,88 @@
+#include "evldt/app/pipeline_options.hpp"
+
+#include <cmath>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+#include <stdexcept>
+
+namespace evldt {
+
+const CLI::Validator& finite_number() {
+  static const CLI::Validator validator(
+      [](std::string& text) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "'" + text + "' is not a finite number";
+        return {};
+      },
+      "FINITE");
+  return validator;
+}
+
+void PipelineOptions::add_to(CLI::App& app) {
+  app.allow_config_extras(CLI::config_extras_mode::error);
+  app.set_config("--config", "", "TOML file of options (keys are the long flag names, e.g. block-size = 14)");
+  auto* group = app.add_option_group("Pipeline", "Line detection and tracking; unset values follow the sensor size");
+  group->add_option("--width", width_, "Sensor width in pixels (default: from the recording's header)")
+      ->check(CLI::Range(1, 32767));
+  group->add_option("--height", height_, "Sensor height in pixels (default: from the recording's header)")
+      ->check(CLI::Range(1, 32767));
+  group->add_option("--block-size", block_size_, "SCARF block size b in pixels (even)")->check(CLI::Range(2, 128));
+  group->add_option("--alpha", alpha_, "Ring capacity factor: N = floor(alpha * b * b / 2)")
+      ->check(finite_number() & CLI::PositiveNumber);
+  group->add_option("--fit-threshold", fit_threshold_, "Fitting-score threshold f_th")
+      ->check(finite_number() & CLI::Range(0.0, 1.0));
+  group->add_option("--inlier-ratio", inlier_ratio_, "Inlier distance d_max as a fraction of b")
+      ->check(finite_number() & CLI::Range(0.01, 1.0));
+  group->add_option("--fit-iterations", fit_iterations_, "Robust reweighting rounds of the line fit")
+      ->check(CLI::Range(0, 20));
+  group->add_option("--perturbation", perturbation_, "Endpoint perturbation dq in pixels")
+      ->check(finite_number() & CLI::Range(0.01, 20.0));
+  group->add_option("--max-bad-tracks", max_bad_tracks_, "Consecutive bad tracking rounds before a line is released")
+      ->check(CLI::Range(1, 1000));
+  group->add_option("--multi-block-norm", multi_block_norm_, "r_e divisor for lines over k blocks: block (N) or union (k*N)")
+      ->check(CLI::IsMember({"block", "union"}));
+  group->add_option("--track-period-us", track_period_, "Deterministic mode: tracking period in event time")
+      ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
+  group->add_option("--detect-period-us", detect_period_, "Deterministic mode: detection period in event time")
+      ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
+  group->add_option("--time-slack-us", time_slack_us_, "Events older than the newest by more than this are dropped")
+      ->capture_default_str()
+      ->check(CLI::Range(Timestamp{0}, Timestamp{60'000'000}));
+}
+
+std::optional<SensorSize> PipelineOptions::sensor() const {
+  if (width_.has_value() != height_.has_value()) throw std::invalid_argument("give both --width and --height, or neither");
+  if (!width_) return std::nullopt;
+  return SensorSize{*width_, *height_};
+}
+
+PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
+  PipelineConfig config = default_config_for(sensor);
+  if (block_size_) config.lattice.block_size = *block_size_;
+  if (alpha_) config.lattice.alpha = *alpha_;
+  if (fit_threshold_) config.score.fit_threshold = *fit_threshold_;
+  if (inlier_ratio_) config.score.inlier_distance_ratio = *inlier_ratio_;
+  if (fit_iterations_) config.score.fit_iterations = *fit_iterations_;
+  if (perturbation_) config.track.perturbation_px = *perturbation_;
+  if (max_bad_tracks_) config.track.max_bad_tracks = *max_bad_tracks_;
+  if (multi_block_norm_) {
+    config.track.multi_block_norm = *multi_block_norm_ == "union" ? EffectiveRatioNorm::Union : EffectiveRatioNorm::Block;
+  }
+  if (track_period_) config.schedule.track_period_us = *track_period_;
+  if (detect_period_) config.schedule.detect_period_us = *detect_period_;
+  return config;
+}
+
+void add_log_level_option(CLI::App& app, std::string& level) {
+  app.add_option("--log-level", level, "Log level: trace, debug, info, warn, error, off")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+}
+
+void apply_log_level(const std::string& level) {
+  // Logs and progress go to stderr, so stdout carries only a tool's results and summary.
+  if (!spdlog::get("evldt")) spdlog::set_default_logger(spdlog::stderr_color_mt("evldt"));
+  spdlog::set_level(spdlog::level::from_str(level));
+}
+
+}  // namespace evldt

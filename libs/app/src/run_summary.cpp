@@ -1,0 +1,81 @@
+#include "evldt/app/run_summary.hpp"
+
+#include <cinttypes>
+#include <fstream>
+#include <stdexcept>
+
+namespace evldt {
+
+namespace {
+
+std::string json_escape(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void RunSummary::add_lines(const LineMap& lines) {
+  lines_created = lines.created();
+  lines_alive = lines.lines().size();
+  for (int r = 0; r < kReleaseReasonCount; ++r) released[r] = lines.released(static_cast<ReleaseReason>(r));
+  lifetimes = lines.released_lifetimes();
+  for (const TrackedLine& line : lines.lines()) lifetimes.add(line.last_good_us - line.first_seen_us);
+}
+
+void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
+  const double mev = static_cast<double>(counters.events) * 1e-6;
+  std::fprintf(out, "evldt summary: %s\n", input.c_str());
+  if (!input_error.empty()) std::fprintf(out, "  input error      %s\n", input_error.c_str());
+  std::fprintf(out, "  events           %" PRIu64 " read, %" PRIu64 " processed, %" PRIu64 " dropped (%" PRIu64
+               " off-sensor, %" PRIu64 " time-backwards)\n",
+               events_read, counters.events, drops.total(), drops.off_sensor, drops.time_backwards);
+  std::fprintf(out, "  event time       %.3f s (%.2f Mev/s)\n", event_seconds, event_seconds > 0 ? mev / event_seconds : 0.0);
+  std::fprintf(out, "  wall time        %.3f s (%.2f Mev/s processed)\n", wall_seconds, wall_seconds > 0 ? mev / wall_seconds : 0.0);
+  std::fprintf(out, "  rounds           %" PRIu64 " tracking, %" PRIu64 " detection, %" PRIu64 " skipped over gaps\n",
+               counters.track_rounds, counters.detect_rounds, counters.skipped_rounds);
+  std::fprintf(out, "  lines            %" PRIu64 " created, %" PRIu64 " alive at the end\n", lines_created, lines_alive);
+  std::fprintf(out, "  released         ");
+  for (int r = 0; r < kReleaseReasonCount; ++r) {
+    std::fprintf(out, "%s%s %" PRIu64, r ? ", " : "", reason_name(static_cast<ReleaseReason>(r)).data(), released[r]);
+  }
+  std::fprintf(out, "\n  lifetime         mean %.1f ms, max %.1f ms (%" PRIu64 " lines)\n", lifetimes.mean_us() * 1e-3,
+               static_cast<double>(lifetimes.max_us) * 1e-3, lifetimes.count);
+  std::fprintf(out, "  output           %" PRIu64 " CSV rows -> %s", csv_rows, csv_path.c_str());
+  if (frames > 0) std::fprintf(out, ", %d frames rendered", frames);
+  std::fprintf(out, "\n");
+}
+
+void RunSummary::write_json(const std::filesystem::path& path) const {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot create " + path.string());
+  out << "{\n  \"input\": \"" << json_escape(input) << "\",\n";
+  out << "  \"input_error\": \"" << json_escape(input_error) << "\",\n";
+  out << "  \"events_read\": " << events_read << ",\n  \"events_processed\": " << counters.events << ",\n";
+  out << "  \"dropped_off_sensor\": " << drops.off_sensor << ",\n  \"dropped_time_backwards\": " << drops.time_backwards << ",\n";
+  out << "  \"event_seconds\": " << event_seconds << ",\n  \"wall_seconds\": " << wall_seconds << ",\n";
+  out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds << ",\n";
+  out << "  \"skipped_rounds\": " << counters.skipped_rounds << ",\n";
+  out << "  \"lines_created\": " << lines_created << ",\n  \"lines_alive\": " << lines_alive << ",\n  \"released\": {";
+  for (int r = 0; r < kReleaseReasonCount; ++r) {
+    out << (r ? ", " : "") << '"' << reason_name(static_cast<ReleaseReason>(r)) << "\": " << released[r];
+  }
+  out << "},\n  \"lifetime_mean_ms\": " << lifetimes.mean_us() * 1e-3 << ",\n";
+  out << "  \"lifetime_max_ms\": " << static_cast<double>(lifetimes.max_us) * 1e-3 << ",\n";
+  out << "  \"csv_rows\": " << csv_rows << ",\n  \"frames\": " << frames << "\n}\n";
+  if (!out) throw std::runtime_error("error writing " + path.string());
+}
+
+}  // namespace evldt

@@ -1,0 +1,135 @@
+#pragma once
+// Incremental decoders: recording bytes in, events out. Input may arrive in chunks of any size; a chunk
+// boundary may split a header line, a text line or a binary word, so every decoder carries the partial
+// piece over to the next chunk.
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "evldt/events/event.hpp"
+#include "evldt/events/event_format.hpp"
+
+namespace evldt {
+
+class EventDecoder {
+ public:
+  virtual ~EventDecoder() = default;
+
+  /// Decodes the chunk, appending every complete valid event to `out`. On corrupt data it appends all
+  /// valid events before the bad bytes and then throws FormatError(source, absolute byte offset, reason).
+  virtual void decode(std::span<const std::uint8_t> chunk, EventBatch& out) = 0;
+
+  /// End of input. Appends the event of a last ECD text line that has no '\n'; throws FormatError at the
+  /// offset of any partial record, word or line (or unterminated header) that remains.
+  virtual void finish(EventBatch& out) = 0;
+
+  /// Sensor size from the file header once it is parsed (EVT 2.0/3.0, dat); nullopt if the header has
+  /// none or the format has no header (ECD text).
+  [[nodiscard]] virtual std::optional<SensorSize> geometry() const = 0;
+};
+
+/// `source_name` (usually the file path) prefixes every FormatError message.
+/// EVT 3.0 events before the first EVT_TIME_HIGH word have no known time and are dropped, not reported.
+/// Time wraps (24-bit EVT 3.0, 34-bit EVT 2.0, 32-bit dat) are unwrapped: a time base that goes back by
+/// half its range or more counts as one wrap, so output times keep increasing over long recordings.
+std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string source_name);
+
+namespace detail {
+
+// One factory per format source file; make_decoder picks among them.
+std::unique_ptr<EventDecoder> make_ecd_text_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_evt3_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_dat_decoder(std::string source_name);
+
+/// The text header that Prophesee RAW and dat files start with: lines beginning with '%'. It ends at the
+/// first line that does not start with '%' (the binary data), or after a "% end" line, which Prophesee
+/// writes last so that data starting with the byte '%' is not taken for header.
+class PercentHeader {
+ public:
+  /// Consumes header bytes from the front of `bytes` and returns how many; the rest is data.
+  /// Throws FormatError for a header line too long to be one (binary data starting with '%').
+  std::size_t consume(std::span<const std::uint8_t> bytes, const std::string& source);
+  /// End of input: a header line without its '\n' means a truncated file.
+  void finish(const std::string& source) const;
+
+  [[nodiscard]] bool complete() const { return complete_; }
+  /// Bytes of header consumed so far; once complete(), the offset of the first data byte.
+  [[nodiscard]] std::uint64_t size() const { return size_; }
+  /// Complete header lines without the line end.
+  [[nodiscard]] const std::vector<std::string>& lines() const { return lines_; }
+
+  /// From "% geometry WxH", "% format NAME;height=H;width=W" or "% Width W" + "% Height H".
+  [[nodiscard]] std::optional<SensorSize> geometry() const;
+  /// The data encoding the header names: "% format EVT3;..." -> "EVT3", "% evt 2.0" -> "EVT2",
+  /// "% evt 2.1" -> "EVT21"; nullopt if it names none.
+  [[nodiscard]] std::optional<std::string> encoding() const;
+
+ private:
+  std::vector<std::string> lines_;
+  std::string line_;           // the header line being read
+  std::uint64_t line_start_ = 0;
+  bool in_line_ = false;
+  bool complete_ = false;
+  std::uint64_t size_ = 0;
+};
+
+/// EVT2 / EVT3 for the encodings "EVT2" / "EVT3"; nullopt for any other.
+std::optional<EventFormat> raw_format_from_encoding(std::string_view encoding);
+
+inline std::uint16_t load_le16(const std::uint8_t* bytes) {
+  return static_cast<std::uint16_t>(bytes[0] | (bytes[1] << 8));
+}
+inline std::uint32_t load_le32(const std::uint8_t* bytes) {
+  return static_cast<std::uint32_t>(bytes[0]) | (static_cast<std::uint32_t>(bytes[1]) << 8) |
+         (static_cast<std::uint32_t>(bytes[2]) << 16) | (static_cast<std::uint32_t>(bytes[3]) << 24);
+}
+
+/// Cuts a byte stream arriving in chunks into fixed-size words, carrying a word split by a chunk
+/// boundary over to the next chunk. A template so that the per-word call inlines.
+template <std::size_t WordBytes>
+class WordSplitter {
+ public:
+  /// Where the first word starts in the file (after the header).
+  void set_offset(std::uint64_t offset) { offset_ = offset; }
+
+  /// Calls on_word(const std::uint8_t* word, std::uint64_t word_offset) for every complete word.
+  template <class OnWord>
+  void feed(std::span<const std::uint8_t> bytes, OnWord&& on_word) {
+    if (carried_ > 0) {
+      const std::size_t take = std::min(WordBytes - carried_, bytes.size());
+      std::copy_n(bytes.data(), take, carry_.data() + carried_);
+      carried_ += take;
+      bytes = bytes.subspan(take);
+      if (carried_ < WordBytes) return;
+      carried_ = 0;
+      on_word(carry_.data(), offset_);
+      offset_ += WordBytes;
+    }
+    const std::size_t whole = bytes.size() - bytes.size() % WordBytes;
+    for (std::size_t i = 0; i < whole; i += WordBytes) on_word(bytes.data() + i, offset_ + i);
+    offset_ += whole;
+    carried_ = bytes.size() - whole;
+    std::copy_n(bytes.data() + whole, carried_, carry_.data());
+  }
+
+  /// Bytes of an incomplete word waiting for the next chunk, and where that word starts.
+  [[nodiscard]] std::size_t carried() const { return carried_; }
+  [[nodiscard]] std::uint64_t offset() const { return offset_; }
+
+ private:
+  std::array<std::uint8_t, WordBytes> carry_{};
+  std::size_t carried_ = 0;
+  std::uint64_t offset_ = 0;  // of the next word to complete
+};
+
+}  // namespace detail
+}  // namespace evldt

@@ -1,0 +1,109 @@
+#include "evldt/events/event_reader.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+
+namespace evldt {
+
+std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string source_name) {
+  switch (format) {
+    case EventFormat::EcdText: return detail::make_ecd_text_decoder(std::move(source_name));
+    case EventFormat::Evt2: return detail::make_evt2_decoder(std::move(source_name));
+    case EventFormat::Evt3: return detail::make_evt3_decoder(std::move(source_name));
+    case EventFormat::Dat: return detail::make_dat_decoder(std::move(source_name));
+  }
+  throw std::invalid_argument("unknown event format");
+}
+
+namespace {
+
+std::string lowercase(std::string text) {
+  std::ranges::transform(text, text.begin(), [](char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; });
+  return text;
+}
+
+}  // namespace
+
+EventFileReader::EventFileReader(const std::filesystem::path& path, std::optional<EventFormat> format, std::size_t chunk_bytes)
+    : source_(path.string()), file_(path, std::ios::binary), chunk_(std::max<std::size_t>(chunk_bytes, 1)) {
+  if (!file_) throw std::runtime_error("cannot open event file '" + source_ + "'");
+  std::error_code size_error;
+  file_size_ = std::filesystem::file_size(path, size_error);
+  if (size_error) file_size_ = 0;
+
+  const std::string extension = lowercase(path.extension().string());
+  const bool format_from_header = !format && extension == ".raw";
+  if (!format && !format_from_header) {
+    if (extension == ".txt") {
+      format = EventFormat::EcdText;
+    } else if (extension == ".dat") {
+      format = EventFormat::Dat;
+    } else {
+      throw std::runtime_error("cannot tell the format of '" + source_ + "' from its name: give it (ecd, evt2, evt3, dat)");
+    }
+  }
+
+  // Read the '%' header now so that format() and geometry() are known before the first read().
+  std::vector<std::uint8_t> header_bytes;
+  if (format != EventFormat::EcdText) {
+    detail::PercentHeader header;
+    while (!header.complete()) {
+      const std::size_t size = read_chunk();
+      if (size == 0) break;
+      header.consume({chunk_.data(), size}, source_);
+      header_bytes.insert(header_bytes.end(), chunk_.begin(), chunk_.begin() + static_cast<std::ptrdiff_t>(size));
+    }
+    if (format_from_header) {
+      const auto encoding = header.encoding();
+      if (!encoding) throw FormatError(source_, 0, "no '% evt' or '% format' header line tells the EVT version; give the format");
+      format = detail::raw_format_from_encoding(*encoding);
+      if (!format) throw FormatError(source_, 0, "the header names the encoding " + *encoding + ", not EVT2 or EVT3");
+    }
+  }
+  format_ = *format;
+  decoder_ = make_decoder(format_, source_);
+  // The chunk(s) read with the header may hold events (and faults): keep them for read().
+  try {
+    decoder_->decode(header_bytes, pending_);
+  } catch (const FormatError&) {
+    pending_error_ = std::current_exception();
+  }
+}
+
+bool EventFileReader::read(EventBatch& out) {
+  out.clear();
+  if (!pending_.empty()) {
+    std::swap(out, pending_);
+    return true;
+  }
+  while (out.empty() && !pending_error_ && !at_end_) {
+    const std::size_t size = read_chunk();
+    try {
+      if (size > 0) {
+        decoder_->decode({chunk_.data(), size}, out);
+      } else {
+        at_end_ = true;
+        decoder_->finish(out);
+      }
+    } catch (const FormatError&) {
+      pending_error_ = std::current_exception();
+    }
+  }
+  if (!out.empty()) return true;  // a fault waits for the next call, after these events
+  if (pending_error_) {
+    at_end_ = true;
+    std::rethrow_exception(std::exchange(pending_error_, nullptr));
+  }
+  return false;
+}
+
+std::size_t EventFileReader::read_chunk() {
+  file_.read(reinterpret_cast<char*>(chunk_.data()), static_cast<std::streamsize>(chunk_.size()));
+  const auto size = static_cast<std::size_t>(file_.gcount());
+  if (file_.bad()) throw std::runtime_error("cannot read event file '" + source_ + "'");
+  bytes_read_ += size;
+  return size;
+}
+
+}  // namespace evldt

@@ -1,0 +1,149 @@
+// Prophesee RAW EVT 2.0: a '%' text header, then little-endian 32-bit words whose top 4 bits are the type.
+//   CD_OFF 0x0 / CD_ON 0x1: [27:22] time bits 0..5, [21:11] x, [10:0] y
+//   EVT_TIME_HIGH 0x8:      [27:0] time bits 6..33
+//   EXT_TRIGGER 0xA, OTHERS 0xE, CONTINUED 0xF: not CD events, skipped; every other type is reserved.
+
+#include <cstdio>
+
+#include "evldt/events/event_decoder.hpp"
+#include "evldt/events/event_writer.hpp"
+
+namespace evldt::detail {
+namespace {
+
+enum Evt2Type : std::uint32_t {
+  kCdOff = 0x0,
+  kCdOn = 0x1,
+  kTimeHigh = 0x8,
+  kExtTrigger = 0xA,
+  kOthers = 0xE,
+  kContinued = 0xF,
+};
+
+constexpr int kTimeLowBits = 6;
+constexpr int kTimeHighBits = 28;
+constexpr std::uint32_t kTimeHighMask = (1u << kTimeHighBits) - 1;
+constexpr int kMaxCoordinate = 2047;  // 11 bits
+// The 28-bit time high wraps every 2^34 us (4.8 h). A time high that goes back by half its range or more
+// is a wrap; the encoder never steps forward by half the range or more, so it cannot be confused.
+constexpr std::uint32_t kTimeHighHalfRange = 1u << (kTimeHighBits - 1);
+constexpr Timestamp kMaxTimeHighStep = kTimeHighHalfRange - 1;
+
+class Evt2Decoder final : public EventDecoder {
+ public:
+  explicit Evt2Decoder(std::string source) : source_(std::move(source)) {}
+
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+    if (!header_.complete()) {
+      const std::size_t used = header_.consume(chunk, source_);
+      chunk = chunk.subspan(used);
+      if (!header_.complete()) return;
+      check_encoding();
+      words_.set_offset(header_.size());
+    }
+    words_.feed(chunk, [&](const std::uint8_t* bytes, std::uint64_t offset) { decode_word(load_le32(bytes), offset, out); });
+  }
+
+  void finish(EventBatch& /*out*/) override {
+    header_.finish(source_);
+    if (words_.carried() > 0) {
+      throw FormatError(source_, words_.offset(),
+                        "file ends inside an EVT 2.0 word (" + std::to_string(words_.carried()) + " of 4 bytes)");
+    }
+  }
+
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return header_.geometry(); }
+
+ private:
+  void check_encoding() const {
+    const auto encoding = header_.encoding();
+    if (encoding && raw_format_from_encoding(*encoding) != EventFormat::Evt2) {
+      throw FormatError(source_, 0, "the header says the data is " + *encoding + ", not EVT2");
+    }
+  }
+
+  void decode_word(std::uint32_t word, std::uint64_t offset, EventBatch& out) {
+    switch (word >> 28) {
+      case kCdOff:
+      case kCdOn:
+        out.push_back(time_high_us_ + ((word >> 22) & 0x3F), static_cast<std::uint16_t>((word >> 11) & 0x7FF),
+                      static_cast<std::uint16_t>(word & 0x7FF), (word >> 28) == kCdOn ? std::int8_t{1} : std::int8_t{-1});
+        return;
+      case kTimeHigh: {
+        const std::uint32_t time_high = word & kTimeHighMask;
+        if (last_time_high_ >= time_high + kTimeHighHalfRange) wraps_ += 1;
+        last_time_high_ = time_high;
+        time_high_us_ = ((wraps_ << kTimeHighBits) + time_high) << kTimeLowBits;
+        return;
+      }
+      case kExtTrigger:
+      case kOthers:
+      case kContinued: return;
+      default: {
+        char reason[64];
+        std::snprintf(reason, sizeof(reason), "reserved EVT 2.0 word type 0x%X (word 0x%08X)", word >> 28, word);
+        throw FormatError(source_, offset, reason);
+      }
+    }
+  }
+
+  std::string source_;
+  PercentHeader header_;
+  WordSplitter<4> words_;
+  // Before the first TIME_HIGH the time high is 0.
+  std::uint32_t last_time_high_ = 0;
+  Timestamp wraps_ = 0;
+  Timestamp time_high_us_ = 0;
+};
+
+class Evt2Encoder final : public EventEncoder {
+ public:
+  explicit Evt2Encoder(SensorSize sensor) : sensor_(sensor) {}
+
+  void write_header(std::vector<std::uint8_t>& out) const override { write_raw_header(2, sensor_, out); }
+
+  void encode(const EventBatch& batch, std::vector<std::uint8_t>& out) override {
+    check_encodable(batch, last_time_, kMaxCoordinate, "EVT 2.0");
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      const Timestamp t = batch.t[i];
+      const Timestamp time_high = t >> kTimeLowBits;
+      // Long gaps go in steps the decoder can follow across the 2^34 us wrap.
+      while (time_high - time_high_ > kMaxTimeHighStep) write_time_high(time_high_ + kMaxTimeHighStep, out);
+      // Always one TIME_HIGH before the first event: other decoders may wait for it.
+      if (time_high != time_high_ || !wrote_time_high_) write_time_high(time_high, out);
+      const std::uint32_t type = batch.p[i] > 0 ? kCdOn : kCdOff;
+      append_le32((type << 28) | (static_cast<std::uint32_t>(t & 0x3F) << 22) |
+                      (static_cast<std::uint32_t>(batch.x[i]) << 11) | batch.y[i],
+                  out);
+    }
+    if (!batch.empty()) last_time_ = batch.t.back();
+  }
+
+ private:
+  void write_time_high(Timestamp time_high, std::vector<std::uint8_t>& out) {
+    time_high_ = time_high;
+    wrote_time_high_ = true;
+    append_le32((std::uint32_t{kTimeHigh} << 28) | (static_cast<std::uint32_t>(time_high) & kTimeHighMask), out);
+  }
+
+  SensorSize sensor_;
+  Timestamp last_time_ = 0;
+  Timestamp time_high_ = 0;  // as the decoder sees it before the first TIME_HIGH
+  bool wrote_time_high_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name) {
+  return std::make_unique<Evt2Decoder>(std::move(source_name));
+}
+
+std::unique_ptr<EventEncoder> make_evt2_encoder(SensorSize sensor) {
+  if (!sensor.valid() || sensor.width > kMaxCoordinate + 1 || sensor.height > kMaxCoordinate + 1) {
+    throw std::invalid_argument("EVT 2.0 describes sensors up to 2048x2048, not " + std::to_string(sensor.width) + "x" +
+                                std::to_string(sensor.height));
+  }
+  return std::make_unique<Evt2Encoder>(sensor);
+}
+
+}  // namespace evldt::detail

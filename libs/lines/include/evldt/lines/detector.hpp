@@ -1,0 +1,24 @@
+#pragma once
+// Line detection (DESIGN 3): per free block, a robust line fit clipped to the block, kept when its
+// fitting score clears the threshold.
+
+#include "evldt/lines/fitting_score.hpp"
+#include "evldt/lines/line_map.hpp"
+#include "evldt/lines/params.hpp"
+
+namespace evldt {
+
+class LineDetector {
+ public:
+  LineDetector(const LatticeGeometry& geometry, const ScoreParams& params);
+
+  /// One detection round over every block; returns the number of lines created.
+  int detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now);
+
+ private:
+  LatticeGeometry geometry_;
+  ScoreParams params_;
+  FittingScorer scorer_;
+};
+
+}  // namespace evldt

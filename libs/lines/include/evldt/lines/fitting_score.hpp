@@ -1,0 +1,44 @@
+#pragma once
+// The fitting score f = r_o * r_e of a segment on a set of lattice entries (DESIGN 3.4).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "evldt/lines/geometry.hpp"
+#include "evldt/scarf/scarf_lattice.hpp"
+
+namespace evldt {
+
+struct ScoreBreakdown {
+  float occupancy = 0;       ///< r_o: share of 1-px bins along the segment hit by an inlier, at most 1
+  float effective = 0;       ///< r_e: inliers / normaliser
+  int inliers = 0;           ///< points of the event set within d_max of the segment, along its length
+  float inlier_distance_sum = 0;  ///< sum of d1 over the inliers
+  [[nodiscard]] float score() const { return occupancy * effective; }
+  [[nodiscard]] float mean_inlier_distance() const { return inliers ? inlier_distance_sum / static_cast<float>(inliers) : 0.0f; }
+  /// Ranks tracking hypotheses: the higher score wins; on a tie (common: f is a ratio of small counts,
+  /// flat while an edge stays within d_max) the segment closer to its inliers wins, so the line
+  /// follows the middle of its event band instead of waiting until the edge has almost left it.
+  [[nodiscard]] bool better_than(const ScoreBreakdown& other) const {
+    const float f = score(), g = other.score();
+    return f > g || (f == g && inliers > 0 && mean_inlier_distance() < other.mean_inlier_distance());
+  }
+};
+
+class FittingScorer {
+ public:
+  /// max_length: the longest segment that will be scored (the sensor diagonal is always enough).
+  FittingScorer(float inlier_distance, float max_length);
+
+  /// Scores `segment` on the event set: the ACTIVE entries, plus the inactive ones when use_inactive is
+  /// set (single-block tracking, so a line can follow an edge leaving its block). r_e = inliers / normaliser.
+  ScoreBreakdown score(const Segment& segment, std::span<const LatticeEntry> entries, bool use_inactive,
+                       float normaliser);
+
+ private:
+  float inlier_distance_;
+  std::vector<std::uint64_t> bins_;  // scratch bitset of occupied 1-px bins, reused across calls
+};
+
+}  // namespace evldt

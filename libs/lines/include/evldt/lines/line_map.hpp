@@ -1,0 +1,93 @@
+#pragma once
+// The lines alive in the lattice and which block administers each (DESIGN 3.5 and 4.6): line ids,
+// block statuses, ownership transfer and detection suppression.
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "evldt/lines/geometry.hpp"
+#include "evldt/scarf/scarf_lattice.hpp"
+
+namespace evldt {
+
+enum class BlockStatus : std::uint8_t {
+  NoDetect,           ///< free: detection may create a line here
+  ProhibitDetection,  ///< skipped by the next detection round (a tracked line is too close)
+  Owned,              ///< administers a line
+};
+
+enum class LineStatus : std::uint8_t { Detected, GoodTrack, BadTrack };
+std::string_view status_name(LineStatus status);
+
+struct TrackedLine {
+  std::uint64_t id = 0;
+  Segment segment;
+  float score = 0;
+  LineStatus status = LineStatus::Detected;
+  int admin_block = -1;
+  Timestamp first_seen_us = 0;
+  Timestamp last_good_us = 0;  ///< last time its score was above threshold (detection counts)
+  int bad_tracks = 0;          ///< consecutive BadTrack rounds
+};
+
+/// Why a line ended; the pipeline's statistics count each.
+enum class ReleaseReason : std::uint8_t { TooFewPoints, TooShort, LeftSensor, BadTracks, LostOwnership };
+inline constexpr int kReleaseReasonCount = 5;
+std::string_view reason_name(ReleaseReason reason);
+
+/// Lifetimes (last good track - first seen) of a set of lines.
+struct LifetimeStats {
+  std::uint64_t count = 0;
+  double sum_us = 0;
+  Timestamp max_us = 0;
+  void add(Timestamp lifetime_us) {
+    ++count;
+    sum_us += static_cast<double>(lifetime_us);
+    if (lifetime_us > max_us) max_us = lifetime_us;
+  }
+  [[nodiscard]] double mean_us() const { return count ? sum_us / static_cast<double>(count) : 0.0; }
+};
+
+class LineMap {
+ public:
+  explicit LineMap(const LatticeGeometry& geometry);
+
+  [[nodiscard]] const std::vector<TrackedLine>& lines() const { return lines_; }
+  [[nodiscard]] std::vector<TrackedLine>& lines() { return lines_; }
+  [[nodiscard]] BlockStatus block_status(int block) const { return status_[block]; }
+  void set_block_status(int block, BlockStatus status);
+
+  /// Creates a line administered by a free block; returns its id.
+  std::uint64_t add(const Segment& segment, float score, int admin_block, Timestamp now);
+  /// Removes the line at `index` (swap-remove: the last line takes its place) and frees its block.
+  void release(std::size_t index, ReleaseReason reason);
+
+  /// Manager, after a tracking round: hand each line to the block its centre moved into (resolving a
+  /// collision in favour of the better score, releasing the other), then mark the admin's row and
+  /// column neighbours within `suppress_ratio * b` of the line centre ProhibitDetection.
+  void manage(float suppress_ratio);
+
+  [[nodiscard]] std::uint64_t released(ReleaseReason reason) const { return released_[static_cast<int>(reason)]; }
+  /// Lifetimes of the lines released so far (add the live ones for a run's total).
+  [[nodiscard]] const LifetimeStats& released_lifetimes() const { return released_lifetimes_; }
+  [[nodiscard]] std::uint64_t created() const { return next_id_ - first_id_; }
+  /// Ids start here; a per-process epoch can be folded in by the caller (services restart).
+  void set_first_id(std::uint64_t first);
+  void clear();
+
+ private:
+  void transfer_ownership();
+  void suppress_detection(float suppress_ratio);
+
+  LatticeGeometry geometry_;
+  std::vector<BlockStatus> status_;
+  std::vector<std::int32_t> owner_;  ///< per block: index into lines_ of the line it administers, or -1
+  std::vector<TrackedLine> lines_;
+  std::uint64_t first_id_ = 1;
+  std::uint64_t next_id_ = 1;
+  std::uint64_t released_[kReleaseReasonCount] = {};
+  LifetimeStats released_lifetimes_;
+};
+
+}  // namespace evldt

@@ -1,0 +1,51 @@
+#pragma once
+// Parameters of the line pipeline (DESIGN section 5), with defaults per sensor resolution.
+
+#include <cstdint>
+
+#include "evldt/events/event.hpp"
+
+namespace evldt {
+
+/// What the active-inlier count of a multi-block tracking score is divided by (DESIGN open question).
+enum class EffectiveRatioNorm : std::uint8_t {
+  Block,  ///< N: long lines spanning k blocks can score r_e up to k
+  Union,  ///< k * N: r_e stays in [0, 1] whatever the number of blocks
+};
+
+struct LatticeParams {
+  SensorSize sensor{640, 480};
+  int block_size = 14;  ///< b
+  double alpha = 1.0;   ///< ring capacity N = floor(alpha * b * b / 2)
+};
+
+struct ScoreParams {
+  float fit_threshold = 0.2f;          ///< f_th: a line is kept while its fitting score f > f_th
+  float inlier_distance_ratio = 0.2f;  ///< d_max = ratio * b
+  int fit_iterations = 3;              ///< robust (Fair-weighted) reweighting rounds after the first PCA fit
+};
+
+struct TrackParams {
+  float perturbation_px = 2.5f;  ///< dq
+  int max_bad_tracks = 3;        ///< consecutive BadTrack rounds before a line is released
+  EffectiveRatioNorm multi_block_norm = EffectiveRatioNorm::Block;
+};
+
+struct ScheduleParams {
+  Timestamp track_period_us = 2000;
+  Timestamp detect_period_us = 4000;
+  /// Event-time gaps longer than this many tracking periods are skipped rather than replayed round by round.
+  int max_catch_up_rounds = 8;
+};
+
+struct PipelineConfig {
+  LatticeParams lattice;
+  ScoreParams score;
+  TrackParams track;
+  ScheduleParams schedule;
+};
+
+/// DESIGN section 5 defaults for a sensor: b and dq from the nearest listed resolution, dq scaled by width.
+PipelineConfig default_config_for(SensorSize sensor);
+
+}  // namespace evldt

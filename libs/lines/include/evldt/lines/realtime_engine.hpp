@@ -1,0 +1,69 @@
+#pragma once
+// The real-time engine (DESIGN 6): the caller's thread stores events as they arrive while detection
+// and tracking loop on their own threads as fast as new events allow. Each loop works on its own
+// copy of the lattice taken under a short lock, so storage never waits for a whole pass; the line
+// state is shared by the two loops under a second lock.
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "evldt/lines/detector.hpp"
+#include "evldt/lines/tracker.hpp"
+
+namespace evldt {
+
+struct EngineCounters {
+  std::uint64_t events = 0;
+  std::uint64_t detect_rounds = 0;
+  std::uint64_t track_rounds = 0;
+  Timestamp latest_event_us = 0;
+};
+
+class RealtimeEngine {
+ public:
+  explicit RealtimeEngine(const PipelineConfig& config);
+  ~RealtimeEngine();
+  RealtimeEngine(const RealtimeEngine&) = delete;
+  RealtimeEngine& operator=(const RealtimeEngine&) = delete;
+
+  void start();
+  void stop();  ///< joins the loops; idempotent
+
+  /// Stores on-sensor, time-ordered events (from one producer thread).
+  void process(const EventBatch& batch);
+
+  /// Copies the live lines into `out` (reusing its capacity) and returns the event time of the lattice
+  /// state they were last tracked or detected on.
+  Timestamp snapshot(std::vector<TrackedLine>& out) const;
+  [[nodiscard]] EngineCounters counters() const;
+  [[nodiscard]] const LatticeGeometry& geometry() const { return lattice_.geometry(); }
+  /// Folds a per-start epoch into line ids so a restarted process never repeats one.
+  void set_first_line_id(std::uint64_t first);
+
+ private:
+  template <typename Round>
+  void loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds, Round round);
+
+  PipelineConfig config_;
+  ScarfLattice lattice_;                      // guarded by lattice_mutex_
+  ScarfLattice detect_view_, track_view_;     // each owned by its loop thread
+  mutable std::mutex lattice_mutex_;
+  std::condition_variable lattice_changed_;
+  std::uint64_t events_stored_ = 0;           // guarded by lattice_mutex_
+  Timestamp latest_event_us_ = 0;             // guarded by lattice_mutex_
+  bool stopping_ = false;                     // guarded by lattice_mutex_
+
+  mutable std::mutex lines_mutex_;
+  LineMap lines_;                             // guarded by lines_mutex_
+  LineDetector detector_;                     // used only under lines_mutex_
+  LineTracker tracker_;                       // used only under lines_mutex_
+  Timestamp lines_time_us_ = 0;               // guarded by lines_mutex_
+
+  std::atomic<std::uint64_t> detect_rounds_{0}, track_rounds_{0};
+  std::thread detect_thread_, track_thread_;
+};
+
+}  // namespace evldt

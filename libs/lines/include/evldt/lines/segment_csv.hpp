@@ -1,0 +1,47 @@
+#pragma once
+// Segments over time as CSV: "t_us,id,x0,y0,x1,y1,score,status", one row per live segment per
+// output step, rows of a step sorted by id. Coordinates are continuous image coordinates.
+
+#include <cstdio>
+#include <filesystem>
+#include <span>
+#include <vector>
+
+#include "evldt/lines/line_map.hpp"
+
+namespace evldt {
+
+inline constexpr const char* kSegmentCsvHeader = "t_us,id,x0,y0,x1,y1,score,status";
+
+class SegmentCsvWriter {
+ public:
+  /// Throws std::runtime_error naming the path if it cannot be created.
+  explicit SegmentCsvWriter(const std::filesystem::path& path);
+  ~SegmentCsvWriter();
+  SegmentCsvWriter(const SegmentCsvWriter&) = delete;
+  SegmentCsvWriter& operator=(const SegmentCsvWriter&) = delete;
+
+  void write_step(Timestamp t, std::span<const TrackedLine> lines);
+  /// Flushes and checks for write errors (throws std::runtime_error).
+  void close();
+  [[nodiscard]] std::uint64_t rows() const { return rows_; }
+
+ private:
+  std::filesystem::path path_;
+  std::FILE* file_ = nullptr;
+  std::vector<const TrackedLine*> sorted_;
+  std::uint64_t rows_ = 0;
+};
+
+struct SegmentRow {
+  Timestamp t_us = 0;
+  std::uint64_t id = 0;
+  Segment segment;
+  float score = 0;
+  LineStatus status = LineStatus::Detected;
+};
+
+/// Reads a whole segment CSV; throws std::runtime_error naming the file and line on malformed input.
+std::vector<SegmentRow> read_segment_csv(const std::filesystem::path& path);
+
+}  // namespace evldt

@@ -1,0 +1,50 @@
+#pragma once
+// Line tracking (DESIGN 4): every live line tries its current segment and four endpoint
+// perturbations along the lattice lines its endpoints sit on, keeps the best-scoring one, and the
+// manager then settles ownership and suppression.
+
+#include <vector>
+
+#include "evldt/lines/fitting_score.hpp"
+#include "evldt/lines/line_map.hpp"
+#include "evldt/lines/params.hpp"
+
+namespace evldt {
+
+/// Appends to `cells` the lattice blocks the segment passes through, in order from q0 (exact grid
+/// traversal; endpoints lying on a border count for the block on the segment's side).
+void blocks_along(const Segment& segment, const LatticeGeometry& geometry, std::vector<int>& cells);
+
+/// Where an endpoint may move: `base` is the endpoint snapped onto its lattice line, `step` the
+/// perturbation vector along that line (dq along x on a horizontal border, along y on a vertical one;
+/// within 1 px of a block corner, along the axis closest to the segment normal).
+struct EndpointMotion {
+  Point2 base;
+  Point2 step;
+};
+EndpointMotion endpoint_motion(const Point2& endpoint, const Point2& segment_direction, const LatticeGeometry& geometry,
+                               float perturbation_px);
+
+/// Distance from a line centre to a neighbouring block below which that block is suppressed (DESIGN 4.6).
+inline constexpr float kSuppressRatio = 0.4f;
+
+class LineTracker {
+ public:
+  LineTracker(const LatticeGeometry& geometry, const ScoreParams& score, const TrackParams& track);
+
+  /// One tracking round over every line, followed by the manager.
+  void track(const ScarfLattice& lattice, LineMap& lines, Timestamp now);
+
+ private:
+  /// Tracks one line; false when it must be released (reason set).
+  bool track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, ReleaseReason& reason);
+
+  LatticeGeometry geometry_;
+  ScoreParams score_params_;
+  TrackParams params_;
+  FittingScorer scorer_;
+  std::vector<int> cells_;               // scratch: blocks under the current line
+  std::vector<LatticeEntry> gathered_;   // scratch: active entries of a multi-block line
+};
+
+}  // namespace evldt

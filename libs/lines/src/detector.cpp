@@ -1,0 +1,41 @@
+#include "evldt/lines/detector.hpp"
+
+#include <cmath>
+
+#include "evldt/lines/line_fit.hpp"
+
+namespace evldt {
+
+LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& params)
+    : geometry_(geometry),
+      params_(params),
+      scorer_(params.inlier_distance_ratio * static_cast<float>(geometry.block_size),
+              static_cast<float>(geometry.block_size) * 1.5f) {}
+
+int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now) {
+  const float b = static_cast<float>(geometry_.block_size);
+  const float capacity = static_cast<float>(geometry_.capacity);
+  int created = 0;
+  for (int block = 0; block < geometry_.block_count(); ++block) {
+    const BlockStatus status = lines.block_status(block);
+    if (status == BlockStatus::ProhibitDetection) {
+      lines.set_block_status(block, BlockStatus::NoDetect);  // suppression lasts one round
+      continue;
+    }
+    if (status != BlockStatus::NoDetect || lattice.active_count(block) < geometry_.min_points()) continue;
+    const auto entries = lattice.entries(block);
+    const auto line = fit_line(entries, params_.fit_iterations);
+    if (!line) continue;
+    const int i = geometry_.column(block), j = geometry_.row(block);
+    const auto segment = clip_to_square(*line, geometry_.origin_x(i), geometry_.origin_y(j), b);
+    if (!segment) continue;
+    const float f = scorer_.score(*segment, entries, /*use_inactive=*/false, capacity).score();
+    if (f > params_.fit_threshold) {
+      lines.add(*segment, f, block, now);
+      ++created;
+    }
+  }
+  return created;
+}
+
+}  // namespace evldt

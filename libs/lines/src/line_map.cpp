@@ -1,0 +1,137 @@
+#include "evldt/lines/line_map.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace evldt {
+
+std::string_view status_name(LineStatus status) {
+  switch (status) {
+    case LineStatus::Detected: return "detected";
+    case LineStatus::GoodTrack: return "good";
+    case LineStatus::BadTrack: return "bad";
+  }
+  return "?";
+}
+
+std::string_view reason_name(ReleaseReason reason) {
+  switch (reason) {
+    case ReleaseReason::TooFewPoints: return "too-few-points";
+    case ReleaseReason::TooShort: return "too-short";
+    case ReleaseReason::LeftSensor: return "left-sensor";
+    case ReleaseReason::BadTracks: return "bad-tracks";
+    case ReleaseReason::LostOwnership: return "lost-ownership";
+  }
+  return "?";
+}
+
+LineMap::LineMap(const LatticeGeometry& geometry)
+    : geometry_(geometry),
+      status_(static_cast<std::size_t>(geometry.block_count()), BlockStatus::NoDetect),
+      owner_(static_cast<std::size_t>(geometry.block_count()), -1) {
+  lines_.reserve(static_cast<std::size_t>(geometry.block_count()));  // at most one line per block
+}
+
+void LineMap::set_block_status(int block, BlockStatus status) {
+  if (status == BlockStatus::Owned || status_[block] == BlockStatus::Owned) {
+    throw std::logic_error("block ownership changes only through add/release/manage");
+  }
+  status_[block] = status;
+}
+
+std::uint64_t LineMap::add(const Segment& segment, float score, int admin_block, Timestamp now) {
+  if (status_[admin_block] == BlockStatus::Owned) throw std::logic_error("a block administers at most one line");
+  TrackedLine line;
+  line.id = next_id_++;
+  line.segment = segment;
+  line.score = score;
+  line.admin_block = admin_block;
+  line.first_seen_us = now;
+  line.last_good_us = now;
+  status_[admin_block] = BlockStatus::Owned;
+  owner_[admin_block] = static_cast<std::int32_t>(lines_.size());
+  lines_.push_back(line);
+  return line.id;
+}
+
+void LineMap::release(std::size_t index, ReleaseReason reason) {
+  const int block = lines_[index].admin_block;
+  released_lifetimes_.add(lines_[index].last_good_us - lines_[index].first_seen_us);
+  status_[block] = BlockStatus::NoDetect;
+  owner_[block] = -1;
+  if (index + 1 != lines_.size()) {
+    lines_[index] = lines_.back();
+    owner_[lines_[index].admin_block] = static_cast<std::int32_t>(index);
+  }
+  lines_.pop_back();
+  ++released_[static_cast<int>(reason)];
+}
+
+void LineMap::manage(float suppress_ratio) {
+  transfer_ownership();
+  suppress_detection(suppress_ratio);
+}
+
+void LineMap::transfer_ownership() {
+  std::size_t i = 0;
+  while (i < lines_.size()) {
+    TrackedLine& line = lines_[i];
+    const Point2 centre = line.segment.centre();
+    const int target = geometry_.block_at(centre.x(), centre.y());
+    if (target < 0 || target == line.admin_block) {  // off the lattice's active area: keep the admin
+      ++i;
+      continue;
+    }
+    if (status_[target] == BlockStatus::Owned) {
+      const auto resident = static_cast<std::size_t>(owner_[target]);
+      if (lines_[resident].score >= line.score) {  // ties keep the resident: no churn
+        release(i, ReleaseReason::LostOwnership);  // a swapped-in line now sits at i: revisit it
+        continue;
+      }
+      // Swap-remove: if the mover was last it now sits in the resident's slot. If the resident sat
+      // before i, the line swapped into its slot waits for the next round's transfer.
+      release(resident, ReleaseReason::LostOwnership);
+      if (i == lines_.size()) i = resident;
+    }
+    TrackedLine& mover = lines_[i];
+    status_[mover.admin_block] = BlockStatus::NoDetect;
+    owner_[mover.admin_block] = -1;
+    mover.admin_block = target;
+    status_[target] = BlockStatus::Owned;
+    owner_[target] = static_cast<std::int32_t>(i);
+    ++i;
+  }
+}
+
+void LineMap::suppress_detection(float suppress_ratio) {
+  const float reach = suppress_ratio * static_cast<float>(geometry_.block_size);
+  const float b = static_cast<float>(geometry_.block_size);
+  for (const TrackedLine& line : lines_) {
+    const int i = geometry_.column(line.admin_block);
+    const int j = geometry_.row(line.admin_block);
+    const Point2 c = line.segment.centre();
+    const float x0 = geometry_.origin_x(i), y0 = geometry_.origin_y(j);
+    auto prohibit = [&](int ni, int nj) {
+      if (ni < 0 || nj < 0 || ni >= geometry_.blocks_x || nj >= geometry_.blocks_y) return;
+      const int block = geometry_.index(ni, nj);
+      if (status_[block] == BlockStatus::NoDetect) status_[block] = BlockStatus::ProhibitDetection;
+    };
+    if (c.x() - x0 < reach) prohibit(i - 1, j);
+    if (x0 + b - c.x() < reach) prohibit(i + 1, j);
+    if (c.y() - y0 < reach) prohibit(i, j - 1);
+    if (y0 + b - c.y() < reach) prohibit(i, j + 1);
+  }
+}
+
+void LineMap::set_first_id(std::uint64_t first) {
+  if (!lines_.empty()) throw std::logic_error("set_first_id before any line exists");
+  first_id_ = next_id_ = first;
+}
+
+void LineMap::clear() {
+  std::fill(status_.begin(), status_.end(), BlockStatus::NoDetect);
+  std::fill(owner_.begin(), owner_.end(), -1);
+  lines_.clear();
+}
+
+}  // namespace evldt

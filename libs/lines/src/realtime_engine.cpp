@@ -1,0 +1,107 @@
+#include "evldt/lines/realtime_engine.hpp"
+
+#include <algorithm>
+
+namespace evldt {
+
+namespace {
+// Longest run of events stored under one lock hold, so the loops' snapshots never wait long.
+constexpr std::size_t kInsertChunk = 8192;
+}  // namespace
+
+RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
+    : config_(config),
+      lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
+      detect_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
+      track_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
+      lines_(lattice_.geometry()),
+      detector_(lattice_.geometry(), config.score),
+      tracker_(lattice_.geometry(), config.score, config.track) {}
+
+RealtimeEngine::~RealtimeEngine() { stop(); }
+
+void RealtimeEngine::start() {
+  if (detect_thread_.joinable()) return;
+  {
+    std::lock_guard lock(lattice_mutex_);
+    stopping_ = false;
+  }
+  detect_thread_ = std::thread([this] {
+    loop(detect_view_, detect_rounds_, [this](const ScarfLattice& view, Timestamp now) { detector_.detect(view, lines_, now); });
+  });
+  track_thread_ = std::thread([this] {
+    loop(track_view_, track_rounds_, [this](const ScarfLattice& view, Timestamp now) { tracker_.track(view, lines_, now); });
+  });
+}
+
+void RealtimeEngine::stop() {
+  {
+    std::lock_guard lock(lattice_mutex_);
+    stopping_ = true;
+  }
+  lattice_changed_.notify_all();
+  if (detect_thread_.joinable()) detect_thread_.join();
+  if (track_thread_.joinable()) track_thread_.join();
+}
+
+void RealtimeEngine::process(const EventBatch& batch) {
+  const std::size_t n = batch.size();
+  for (std::size_t begin = 0; begin < n; begin += kInsertChunk) {
+    const std::size_t end = std::min(n, begin + kInsertChunk);
+    {
+      std::lock_guard lock(lattice_mutex_);
+      for (std::size_t i = begin; i < end; ++i) lattice_.insert(batch.x[i], batch.y[i]);
+      events_stored_ += end - begin;
+      latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
+    }
+    lattice_changed_.notify_all();
+  }
+}
+
+template <typename Round>
+void RealtimeEngine::loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds, Round round) {
+  std::uint64_t seen = 0;
+  for (;;) {
+    Timestamp now = 0;
+    {
+      std::unique_lock lock(lattice_mutex_);
+      // A round on an unchanged lattice would repeat the last one: wait for new events.
+      lattice_changed_.wait(lock, [&] { return stopping_ || events_stored_ != seen; });
+      if (stopping_) return;
+      view.copy_state_from(lattice_);
+      seen = events_stored_;
+      now = latest_event_us_;
+    }
+    {
+      std::lock_guard lock(lines_mutex_);
+      round(view, now);
+      lines_time_us_ = std::max(lines_time_us_, now);
+    }
+    rounds.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+Timestamp RealtimeEngine::snapshot(std::vector<TrackedLine>& out) const {
+  std::lock_guard lock(lines_mutex_);
+  out.assign(lines_.lines().begin(), lines_.lines().end());
+  return lines_time_us_;
+}
+
+EngineCounters RealtimeEngine::counters() const {
+  EngineCounters c;
+  {
+    std::lock_guard lock(lattice_mutex_);
+    c.events = events_stored_;
+    c.latest_event_us = latest_event_us_;
+  }
+  c.detect_rounds = detect_rounds_.load(std::memory_order_relaxed);
+  c.track_rounds = track_rounds_.load(std::memory_order_relaxed);
+  return c;
+}
+
+void RealtimeEngine::set_first_line_id(std::uint64_t first) {
+  std::lock_guard lock(lines_mutex_);
+  lines_.set_first_id(first);
+}
+
+}  // namespace evldt

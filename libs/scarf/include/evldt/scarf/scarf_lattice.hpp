@@ -1,0 +1,127 @@
+#pragma once
+// SCARF: "Set of Centre Active Receptive Fields" (DESIGN section 2).
+//
+// The sensor is tiled by b x b blocks with a half-block margin. Each block keeps a fixed ring of the
+// N most recent events that fell into its active region (ACTIVE) or into the half-block band around
+// it (INACTIVE). Because a block holds a fixed number of events rather than a time window, an edge
+// leaves the same number of active entries whatever its speed; inactive entries push stale active
+// ones out once an edge has left the block.
+//
+// Coordinates: pixel (x, y) covers [x, x+1) x [y, y+1) in continuous image coordinates, so block
+// (i, j) covers [b/2 + i*b, b/2 + (i+1)*b) x [b/2 + j*b, b/2 + (j+1)*b) and block borders lie on
+// integer lattice lines.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "evldt/events/event.hpp"
+
+namespace evldt {
+
+/// One ring-buffer entry: pixel and ACTIVE flag packed into 4 bytes (y uses 15 bits).
+struct LatticeEntry {
+  std::uint16_t x = 0;
+  std::uint16_t y_and_flag = 0;
+
+  static constexpr std::uint16_t kActiveBit = 0x8000;
+  [[nodiscard]] std::uint16_t y() const { return static_cast<std::uint16_t>(y_and_flag & ~kActiveBit); }
+  [[nodiscard]] bool active() const { return (y_and_flag & kActiveBit) != 0; }
+  /// Centre of the pixel in continuous image coordinates.
+  [[nodiscard]] float cx() const { return static_cast<float>(x) + 0.5f; }
+  [[nodiscard]] float cy() const { return static_cast<float>(y()) + 0.5f; }
+};
+
+/// Size and placement of the blocks. Block index = j * blocks_x + i.
+struct LatticeGeometry {
+  SensorSize sensor;
+  int block_size = 0;  ///< b, even
+  int blocks_x = 0;    ///< floor(W / b) - 1
+  int blocks_y = 0;    ///< floor(H / b) - 1
+  int capacity = 0;    ///< N = floor(alpha * b * b / 2) entries per block
+
+  /// Throws std::invalid_argument with a clear message on an unusable combination.
+  static LatticeGeometry make(SensorSize sensor, int block_size, double alpha);
+
+  [[nodiscard]] int block_count() const { return blocks_x * blocks_y; }
+  [[nodiscard]] int index(int i, int j) const { return j * blocks_x + i; }
+  [[nodiscard]] int column(int block) const { return block % blocks_x; }
+  [[nodiscard]] int row(int block) const { return block / blocks_x; }
+  [[nodiscard]] float origin_x(int i) const { return static_cast<float>(block_size / 2 + i * block_size); }
+  [[nodiscard]] float origin_y(int j) const { return static_cast<float>(block_size / 2 + j * block_size); }
+  /// Block whose active region holds the continuous point, or -1.
+  [[nodiscard]] int block_at(float x, float y) const;
+  /// Fewest active points a block (or a line's blocks) must hold to be worth fitting: max(N/10, 3).
+  [[nodiscard]] int min_points() const { return capacity / 10 > 3 ? capacity / 10 : 3; }
+};
+
+class ScarfLattice {
+ public:
+  /// keep_surface: maintain the per-pixel count of active entries (for display); costs a little per event.
+  ScarfLattice(SensorSize sensor, int block_size, double alpha, bool keep_surface = false);
+
+  /// Stores one on-sensor event (the caller validates coordinates). O(1), never allocates.
+  void insert(std::uint16_t x, std::uint16_t y) {
+    const std::int32_t home_i = column_home_[x];
+    const std::int32_t home_j = row_home_[y];
+    const std::int32_t side_i = column_side_[x];
+    const std::int32_t side_j = row_side_[y];
+    const std::uint16_t y_active = static_cast<std::uint16_t>(y | LatticeEntry::kActiveBit);
+    if (home_i >= 0 && home_j >= 0) push(home_j + home_i, {x, y_active});
+    if (side_i >= 0 && home_j >= 0) push(home_j + side_i, {x, y});
+    if (home_i >= 0 && side_j >= 0) push(side_j + home_i, {x, y});
+    if (side_i >= 0 && side_j >= 0) push(side_j + side_i, {x, y});
+  }
+  void insert(const EventBatch& batch);
+
+  [[nodiscard]] const LatticeGeometry& geometry() const { return geometry_; }
+  /// The entries a block currently holds (at most N, in no particular order).
+  [[nodiscard]] std::span<const LatticeEntry> entries(int block) const {
+    return {entries_.data() + static_cast<std::size_t>(block) * geometry_.capacity, blocks_[block].filled};
+  }
+  [[nodiscard]] int active_count(int block) const { return blocks_[block].active; }
+  /// Per-pixel number of active entries, row-major W x H; empty unless keep_surface was set.
+  [[nodiscard]] const std::vector<std::uint16_t>& surface() const { return surface_; }
+
+  /// Copies the ring contents of a lattice of the same geometry without allocating (the surface is
+  /// not copied). Used by the real-time engine to give each loop a consistent view.
+  void copy_state_from(const ScarfLattice& other);
+  void clear();
+
+ private:
+  struct BlockState {
+    std::uint16_t head = 0;    ///< next slot to overwrite
+    std::uint16_t filled = 0;  ///< slots in use (reaches N and stays)
+    std::uint16_t active = 0;  ///< ACTIVE entries among them
+  };
+
+  void push(std::int32_t block, LatticeEntry entry) {
+    BlockState& state = blocks_[block];
+    LatticeEntry& slot = entries_[static_cast<std::size_t>(block) * geometry_.capacity + state.head];
+    if (state.filled == geometry_.capacity) {
+      if (slot.active()) {
+        --state.active;
+        if (!surface_.empty()) --surface_[static_cast<std::size_t>(slot.y()) * geometry_.sensor.width + slot.x];
+      }
+    } else {
+      ++state.filled;
+    }
+    slot = entry;
+    if (entry.active()) {
+      ++state.active;
+      if (!surface_.empty()) ++surface_[static_cast<std::size_t>(entry.y()) * geometry_.sensor.width + entry.x];
+    }
+    state.head = static_cast<std::uint16_t>(state.head + 1 == geometry_.capacity ? 0 : state.head + 1);
+  }
+
+  LatticeGeometry geometry_;
+  // Per pixel column / row: the block column (row) whose active region holds it, and the one on
+  // the side of the half it lies in, whose extended region also holds it; -1 where there is none.
+  // Row tables are pre-multiplied by blocks_x so a block index is a single add.
+  std::vector<std::int32_t> column_home_, column_side_, row_home_, row_side_;
+  std::vector<BlockState> blocks_;
+  std::vector<LatticeEntry> entries_;
+  std::vector<std::uint16_t> surface_;
+};
+
+}  // namespace evldt

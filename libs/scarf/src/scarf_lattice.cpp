@@ -1,0 +1,106 @@
+#include "evldt/scarf/scarf_lattice.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace evldt {
+
+namespace {
+
+// Largest coordinate a LatticeEntry can hold (y keeps 15 bits).
+constexpr int kMaxSensorSide = 32767;
+
+}  // namespace
+
+LatticeGeometry LatticeGeometry::make(SensorSize sensor, int block_size, double alpha) {
+  if (!sensor.valid() || sensor.width > kMaxSensorSide || sensor.height > kMaxSensorSide) {
+    throw std::invalid_argument("sensor size " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height) +
+                                " is not in 1.." + std::to_string(kMaxSensorSide));
+  }
+  if (block_size < 2 || block_size % 2 != 0 || block_size > 128) {
+    throw std::invalid_argument("block size " + std::to_string(block_size) + " must be even and in 2..128");
+  }
+  if (!(alpha > 0.0) || !std::isfinite(alpha)) {
+    throw std::invalid_argument("alpha must be a positive number");
+  }
+  LatticeGeometry g;
+  g.sensor = sensor;
+  g.block_size = block_size;
+  g.blocks_x = sensor.width / block_size - 1;
+  g.blocks_y = sensor.height / block_size - 1;
+  const double capacity = std::floor(alpha * block_size * block_size / 2.0);
+  if (g.blocks_x < 1 || g.blocks_y < 1) {
+    throw std::invalid_argument("block size " + std::to_string(block_size) + " leaves no block on a " +
+                                std::to_string(sensor.width) + "x" + std::to_string(sensor.height) + " sensor");
+  }
+  if (capacity < 3 || capacity > 65535) {
+    throw std::invalid_argument("alpha * b * b / 2 = " + std::to_string(capacity) + " entries per block is outside 3..65535");
+  }
+  g.capacity = static_cast<int>(capacity);
+  return g;
+}
+
+int LatticeGeometry::block_at(float x, float y) const {
+  const float u = (x - static_cast<float>(block_size / 2)) / static_cast<float>(block_size);
+  const float v = (y - static_cast<float>(block_size / 2)) / static_cast<float>(block_size);
+  if (!(u >= 0.0f) || !(v >= 0.0f)) return -1;  // also rejects NaN
+  const int i = static_cast<int>(u);
+  const int j = static_cast<int>(v);
+  if (i >= blocks_x || j >= blocks_y) return -1;
+  return index(i, j);
+}
+
+namespace {
+
+// For one axis of `length` pixels: the home block and the side block of every pixel (see header).
+void build_axis_tables(int length, int block_size, int blocks, int stride, std::vector<std::int32_t>& home,
+                       std::vector<std::int32_t>& side) {
+  home.assign(static_cast<std::size_t>(length), -1);
+  side.assign(static_cast<std::size_t>(length), -1);
+  const int half = block_size / 2;
+  for (int p = 0; p < length; ++p) {
+    const int shifted = p - half;
+    // floor division, so the margin before block 0 maps to block -1
+    const int cell = shifted >= 0 ? shifted / block_size : -1;
+    const int offset = shifted - cell * block_size;
+    const int neighbour = offset < half ? cell - 1 : cell + 1;
+    if (cell >= 0 && cell < blocks) home[p] = cell * stride;
+    if (neighbour >= 0 && neighbour < blocks) side[p] = neighbour * stride;
+  }
+}
+
+}  // namespace
+
+ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool keep_surface)
+    : geometry_(LatticeGeometry::make(sensor, block_size, alpha)) {
+  build_axis_tables(sensor.width, block_size, geometry_.blocks_x, 1, column_home_, column_side_);
+  build_axis_tables(sensor.height, block_size, geometry_.blocks_y, geometry_.blocks_x, row_home_, row_side_);
+  blocks_.resize(static_cast<std::size_t>(geometry_.block_count()));
+  entries_.resize(static_cast<std::size_t>(geometry_.block_count()) * geometry_.capacity);
+  if (keep_surface) surface_.assign(static_cast<std::size_t>(sensor.width) * sensor.height, 0);
+}
+
+void ScarfLattice::insert(const EventBatch& batch) {
+  const std::size_t n = batch.size();
+  const std::uint16_t* xs = batch.x.data();
+  const std::uint16_t* ys = batch.y.data();
+  for (std::size_t i = 0; i < n; ++i) insert(xs[i], ys[i]);
+}
+
+void ScarfLattice::copy_state_from(const ScarfLattice& other) {
+  if (other.geometry_.sensor != geometry_.sensor || other.geometry_.block_size != geometry_.block_size ||
+      other.geometry_.capacity != geometry_.capacity) {
+    throw std::invalid_argument("copy_state_from: lattices differ in geometry");
+  }
+  std::copy(other.blocks_.begin(), other.blocks_.end(), blocks_.begin());
+  std::copy(other.entries_.begin(), other.entries_.end(), entries_.begin());
+}
+
+void ScarfLattice::clear() {
+  std::fill(blocks_.begin(), blocks_.end(), BlockState{});
+  std::fill(surface_.begin(), surface_.end(), std::uint16_t{0});
+}
+
+}  // namespace evldt

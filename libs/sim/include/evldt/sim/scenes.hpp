@@ -1,0 +1,18 @@
+#pragma once
+// The built-in scenes, by name (see README: each mirrors a recording of the seed paper).
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "evldt/sim/scene.hpp"
+
+namespace evldt {
+
+inline constexpr std::string_view kDefaultScene = "boxes-6dof";
+
+const std::vector<std::string>& scene_names();
+/// Throws std::invalid_argument listing the valid names for an unknown one.
+Scene make_scene(std::string_view name);
+
+}  // namespace evldt

@@ -1,0 +1,167 @@
+#include "evldt/sim/event_simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <tuple>
+
+namespace evldt {
+
+namespace {
+
+// Linear intensity -> log intensity, with a floor so black is finite (as a real pixel's dark current).
+float log_intensity(double brightness) { return static_cast<float>(std::log(std::max(brightness, 0.0) + 0.02)); }
+
+// Pixels whose centre (x + 0.5, y + 0.5) is inside the convex polygon get `value`.
+void fill_convex(const std::vector<Vec2d>& polygon, float value, int width, int height, std::vector<float>& image) {
+  double top = 1e300, bottom = -1e300;
+  for (const Vec2d& v : polygon) {
+    top = std::min(top, v.y());
+    bottom = std::max(bottom, v.y());
+  }
+  const int y_first = std::max(0, static_cast<int>(std::ceil(top - 0.5)));
+  const int y_last = std::min(height - 1, static_cast<int>(std::floor(bottom - 0.5)));
+  for (int y = y_first; y <= y_last; ++y) {
+    const double yc = y + 0.5;
+    double left = 1e300, right = -1e300;
+    for (std::size_t i = 0; i < polygon.size(); ++i) {
+      const Vec2d& p = polygon[i];
+      const Vec2d& q = polygon[(i + 1) % polygon.size()];
+      if ((p.y() <= yc && q.y() > yc) || (q.y() <= yc && p.y() > yc)) {
+        const double x = p.x() + (yc - p.y()) * (q.x() - p.x()) / (q.y() - p.y());
+        left = std::min(left, x);
+        right = std::max(right, x);
+      }
+    }
+    if (left >= right) continue;
+    const int x_first = std::max(0, static_cast<int>(std::ceil(left - 0.5)));
+    const int x_end = std::min(width, static_cast<int>(std::ceil(right - 0.5)));
+    if (x_first < x_end) std::fill(image.begin() + static_cast<std::ptrdiff_t>(y) * width + x_first,
+                                   image.begin() + static_cast<std::ptrdiff_t>(y) * width + x_end, value);
+  }
+}
+
+}  // namespace
+
+EventSimulator::EventSimulator(Scene scene, const SimulatorConfig& config)
+    : scene_(std::move(scene)), config_(config), random_(config.seed), width_(scene_.sensor.width), height_(scene_.sensor.height) {
+  if (!scene_.sensor.valid()) throw std::invalid_argument("scene has no sensor size");
+  if (!(config.contrast_on > 0) || !(config.contrast_off > 0) || !(config.max_step_px > 0) || config.max_step_us <= 0) {
+    throw std::invalid_argument("contrast thresholds and step limits must be positive");
+  }
+  const std::size_t pixels = static_cast<std::size_t>(width_) * height_;
+  threshold_on_.resize(pixels);
+  threshold_off_.resize(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    threshold_on_[i] = static_cast<float>(std::max(0.02, config.contrast_on + config.contrast_sigma * random_.normal()));
+    threshold_off_[i] = static_cast<float>(std::max(0.02, config.contrast_off + config.contrast_sigma * random_.normal()));
+  }
+  for (int i = 0; i < config.hot_pixels; ++i) hot_pixels_.push_back(static_cast<std::uint32_t>(random_.below(pixels)));
+  last_event_.assign(pixels, -config.refractory_us - 1);
+  log_now_.resize(pixels);
+  render(0.0, log_now_);
+  log_prev_ = log_now_;
+  log_reference_ = log_now_;
+  const double noise_total = config.noise_rate_hz * static_cast<double>(pixels);
+  next_noise_s_ = noise_total > 0 ? random_.exponential(1.0 / noise_total) : 1e300;
+  const double hot_total = config.hot_rate_hz * static_cast<double>(hot_pixels_.size());
+  next_hot_s_ = hot_total > 0 ? random_.exponential(1.0 / hot_total) : 1e300;
+}
+
+void EventSimulator::render(double t, std::vector<float>& log_image) {
+  std::fill(log_image.begin(), log_image.end(), log_intensity(scene_.background));
+  for (std::size_t k = 0; k < scene_.shapes.size(); ++k) {
+    fill_convex(scene_.polygon_at(k, t), log_intensity(scene_.shapes[k].brightness), width_, height_, log_image);
+  }
+}
+
+Timestamp EventSimulator::next_step() {
+  // Largest step (up to max_step_us) over which no vertex moves more than max_step_px.
+  Timestamp step = std::min(config_.max_step_us, scene_.duration_us - rendered_);
+  const double t0 = static_cast<double>(rendered_) * 1e-6;
+  for (int attempt = 0; attempt < 16 && step > 1; ++attempt) {
+    const double t1 = static_cast<double>(rendered_ + step) * 1e-6;
+    double largest = 0;
+    for (std::size_t k = 0; k < scene_.shapes.size(); ++k) {
+      const auto a = scene_.polygon_at(k, t0), b = scene_.polygon_at(k, t1);
+      for (std::size_t v = 0; v < a.size(); ++v) largest = std::max(largest, (b[v] - a[v]).norm());
+    }
+    if (largest <= config_.max_step_px) break;
+    step = std::max<Timestamp>(1, static_cast<Timestamp>(static_cast<double>(step) * config_.max_step_px / largest * 0.95));
+  }
+  return rendered_ + step;
+}
+
+void EventSimulator::emit_signal(Timestamp t0, Timestamp t1) {
+  const double span = static_cast<double>(t1 - t0);
+  const std::size_t pixels = log_now_.size();
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const float before = log_prev_[i], after = log_now_[i];
+    if (after == before) continue;
+    float& reference = log_reference_[i];
+    const float on = threshold_on_[i], off = threshold_off_[i];
+    const bool rising = after > reference;
+    const float threshold = rising ? on : off;
+    const int crossings = static_cast<int>(std::floor(std::abs(after - reference) / threshold));
+    for (int m = 1; m <= crossings; ++m) {
+      const float level = reference + (rising ? 1.0f : -1.0f) * static_cast<float>(m) * threshold;
+      const double fraction = std::clamp(static_cast<double>((level - before) / (after - before)), 0.0, 1.0);
+      const Timestamp t = t0 + std::max<Timestamp>(1, static_cast<Timestamp>(std::llround(fraction * span)));
+      if (t - last_event_[i] < config_.refractory_us) {
+        ++counters_.refractory_losses;
+        continue;
+      }
+      last_event_[i] = t;
+      pending_.push_back({t, static_cast<std::uint16_t>(i % static_cast<std::size_t>(width_)),
+                          static_cast<std::uint16_t>(i / static_cast<std::size_t>(width_)), static_cast<std::int8_t>(rising ? 1 : -1)});
+      ++counters_.signal_events;
+    }
+    reference += (rising ? 1.0f : -1.0f) * static_cast<float>(crossings) * threshold;
+  }
+}
+
+void EventSimulator::emit_noise(Timestamp t0, Timestamp t1) {
+  const double end_s = static_cast<double>(t1) * 1e-6;
+  const std::size_t pixels = log_now_.size();
+  const double noise_total = config_.noise_rate_hz * static_cast<double>(pixels);
+  auto fire = [&](double time_s, std::size_t pixel) {
+    const Timestamp t = std::clamp<Timestamp>(static_cast<Timestamp>(std::ceil(time_s * 1e6)), t0 + 1, t1);
+    pending_.push_back({t, static_cast<std::uint16_t>(pixel % static_cast<std::size_t>(width_)),
+                        static_cast<std::uint16_t>(pixel / static_cast<std::size_t>(width_)),
+                        static_cast<std::int8_t>(random_.below(2) ? 1 : -1)});
+    ++counters_.noise_events;
+  };
+  while (next_noise_s_ <= end_s) {
+    fire(next_noise_s_, random_.below(pixels));
+    next_noise_s_ += random_.exponential(1.0 / noise_total);
+  }
+  while (next_hot_s_ <= end_s) {
+    fire(next_hot_s_, hot_pixels_[random_.below(hot_pixels_.size())]);
+    next_hot_s_ += random_.exponential(1.0 / (config_.hot_rate_hz * static_cast<double>(hot_pixels_.size())));
+  }
+}
+
+bool EventSimulator::run_until(Timestamp until_us, EventBatch& out) {
+  const Timestamp limit = std::min(until_us, scene_.duration_us);
+  const std::size_t before = out.size();
+  while (rendered_ < limit) {
+    const Timestamp t1 = next_step();
+    std::swap(log_prev_, log_now_);
+    render(static_cast<double>(t1) * 1e-6, log_now_);
+    // Drop what was handed out, then sort the new sub-frame's events behind the rest.
+    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_head_));
+    pending_head_ = 0;
+    const std::size_t first_new = pending_.size();
+    emit_signal(rendered_, t1);
+    emit_noise(rendered_, t1);
+    std::stable_sort(pending_.begin() + static_cast<std::ptrdiff_t>(first_new), pending_.end(),
+                     [](const Event& a, const Event& b) { return std::tie(a.t, a.y, a.x) < std::tie(b.t, b.y, b.x); });
+    rendered_ = t1;
+    ++counters_.sub_frames;
+  }
+  while (pending_head_ < pending_.size() && pending_[pending_head_].t <= limit) out.push_back(pending_[pending_head_++]);
+  now_ = std::max(now_, limit);
+  return out.size() > before || now_ < scene_.duration_us;
+}
+
+}  // namespace evldt

@@ -1,0 +1,117 @@
+#include "evldt/sim/scenes.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace evldt {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+std::vector<Vec2d> rectangle(double x0, double y0, double x1, double y1) { return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}; }
+
+std::vector<Vec2d> regular_polygon(Vec2d centre, double radius, int sides, double rotation) {
+  std::vector<Vec2d> out;
+  for (int i = 0; i < sides; ++i) {
+    const double a = rotation + kTwoPi * i / sides;
+    out.emplace_back(centre.x() + radius * std::cos(a), centre.y() + radius * std::sin(a));
+  }
+  return out;
+}
+
+Shape solid(std::vector<Vec2d> polygon, double brightness, bool straight = true) {
+  Shape s;
+  s.polygon = std::move(polygon);
+  s.brightness = brightness;
+  s.straight_edges = straight;
+  return s;
+}
+
+MotionChannel sine(double amplitude, double frequency_hz, double phase = 0) { return {0, 0, amplitude, frequency_hz, phase}; }
+
+// Three dark vertical bars taller than the view, swept fast left and right (peak ~940 px/s).
+Scene three_lines_fast() {
+  Scene s{"three-lines-fast", {640, 480}, 0.8, {}, {}, 1'000'000};
+  for (const double x : {200.0, 320.0, 440.0}) s.shapes.push_back(solid(rectangle(x - 15, -20, x + 15, 500), 0.15));
+  s.camera.tx = sine(150, 1.0);
+  return s;
+}
+
+// A bright board with a dark circle and a dark square, moving mostly horizontally, so its
+// horizontal edges produce few events.
+Scene circle_board() {
+  Scene s{"circle-board", {640, 480}, 0.2, {}, {}, 1'500'000};
+  s.shapes.push_back(solid(rectangle(130, 110, 510, 370), 0.85));
+  s.shapes.push_back(solid(regular_polygon({250, 240}, 70, 64, 0), 0.15, /*straight=*/false));
+  s.shapes.push_back(solid(rectangle(360, 180, 450, 300), 0.15));
+  s.camera.tx = sine(110, 0.8);
+  s.camera.ty = sine(6, 0.5, 1.0);
+  return s;
+}
+
+// Boxes and polygons under camera motion that turns, zooms and tilts, at changing speed.
+Scene boxes_6dof() {
+  Scene s{"boxes-6dof", {240, 180}, 0.45, {}, {}, 2'000'000};
+  s.shapes.push_back(solid(rectangle(30, 30, 100, 80), 0.9));
+  s.shapes.push_back(solid(rectangle(140, 25, 205, 95), 0.1));
+  s.shapes.push_back(solid(regular_polygon({70, 130}, 32, 3, 0.3), 0.85));
+  s.shapes.push_back(solid(regular_polygon({165, 135}, 30, 5, 0.0), 0.12));
+  s.shapes.push_back(solid(rectangle(85, 65, 130, 110), 0.7));
+  s.camera.pivot = {120, 90};
+  s.camera.tx = {0, 0, 25, 0.45, 0};
+  s.camera.ty = {0, 0, 15, 0.7, 1.0};
+  s.camera.angle = sine(0.2, 0.35, 0.5);
+  s.camera.log_scale = sine(0.12, 0.3, 2.0);
+  s.camera.perspective_x = sine(4e-4, 0.25);
+  s.camera.perspective_y = sine(3e-4, 0.2, 1.5);
+  return s;
+}
+
+// Three bars in separate bands at 15, 80 and up to ~500 px/s: SCARF keeps the same number of
+// events per block whatever the speed.
+Scene multi_speed() {
+  Scene s{"multi-speed", {346, 260}, 0.75, {}, {}, 1'500'000};
+  const double bands[3][2] = {{15, 80}, {95, 165}, {180, 250}};
+  for (int k = 0; k < 3; ++k) s.shapes.push_back(solid(rectangle(150, bands[k][0], 190, bands[k][1]), 0.15));
+  s.shapes[0].motion.tx = {-40, 15, 0, 0, 0};
+  s.shapes[1].motion.tx = {-60, 80, 0, 0, 0};
+  s.shapes[2].motion.tx = sine(120, 0.65);
+  return s;
+}
+
+// A dense grid of window-like rectangles at 1280x720 under camera motion: > 10 Mev/s.
+Scene monitor_hd() {
+  Scene s{"monitor-hd", {1280, 720}, 0.55, {}, {}, 500'000};
+  for (int row = 0; row < 7; ++row) {
+    for (int col = 0; col < 12; ++col) {
+      const double x = 60 + col * 98, y = 40 + row * 92;
+      s.shapes.push_back(solid(rectangle(x, y, x + 66, y + 58), (row + col) % 2 ? 0.3 : 0.85));
+    }
+  }
+  s.camera.pivot = {640, 360};
+  s.camera.tx = sine(180, 1.2);
+  s.camera.ty = sine(60, 0.9, 0.7);
+  s.camera.angle = sine(0.04, 0.8);
+  return s;
+}
+
+}  // namespace
+
+const std::vector<std::string>& scene_names() {
+  static const std::vector<std::string> names{"three-lines-fast", "circle-board", "boxes-6dof", "multi-speed", "monitor-hd"};
+  return names;
+}
+
+Scene make_scene(std::string_view name) {
+  if (name == "three-lines-fast") return three_lines_fast();
+  if (name == "circle-board") return circle_board();
+  if (name == "boxes-6dof") return boxes_6dof();
+  if (name == "multi-speed") return multi_speed();
+  if (name == "monitor-hd") return monitor_hd();
+  std::string valid;
+  for (const auto& n : scene_names()) valid += (valid.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown scene '" + std::string(name) + "' (built-in scenes: " + valid + ")");
+}
+
+}  // namespace evldt

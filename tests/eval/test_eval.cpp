@@ -1,0 +1,400 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "evldt/eval/accumulator.hpp"
+#include "evldt/eval/json.hpp"
+#include "evldt/eval/line_heatmap.hpp"
+#include "evldt/eval/plots.hpp"
+
+namespace evldt {
+namespace {
+
+// 100 x 75: the diagonal is 125 px, so 1% is 1.25 px (1 px, not sqrt(2)) and 2% is 2.5 px (up to
+// sqrt(5), not sqrt(8)): no pixel distance lies near a tolerance.
+constexpr SensorSize kSensor{100, 75};
+constexpr std::size_t kWidth = 100;
+
+/// Horizontal segment through the middle of row y, over the pixels x0 .. x1 (x1 - x0 + 1 pixels).
+Segment row_segment(int y, int x0, int x1) {
+  const float yc = static_cast<float>(y) + 0.5f;
+  return {Point2(static_cast<float>(x0) + 0.5f, yc), Point2(static_cast<float>(x1) + 0.5f, yc)};
+}
+
+std::size_t line_pixels(const std::vector<std::uint8_t>& map) {
+  return static_cast<std::size_t>(std::count(map.begin(), map.end(), std::uint8_t{1}));
+}
+
+void expect_prf(const Prf& actual, double precision, double recall, double f) {
+  EXPECT_DOUBLE_EQ(actual.precision, precision);
+  EXPECT_DOUBLE_EQ(actual.recall, recall);
+  EXPECT_DOUBLE_EQ(actual.f, f);
+}
+
+TEST(Rasterise, MarksEveryPixelAlongTheSegmentAndClipsAtTheBorder) {
+  std::vector<std::uint8_t> map;
+  const std::vector<Segment> inside = {row_segment(20, 10, 50)};
+  rasterise(inside, kSensor, map);
+  ASSERT_EQ(map.size(), 100u * 75u);
+  EXPECT_EQ(line_pixels(map), 41u);
+  EXPECT_EQ(map[20 * kWidth + 10], 1);
+  EXPECT_EQ(map[20 * kWidth + 50], 1);
+  EXPECT_EQ(map[20 * kWidth + 51], 0);
+
+  const std::vector<Segment> partly_off = {{Point2(-10.5f, 5.5f), Point2(5.5f, 5.5f)},      // x 0 .. 5 visible
+                                           {Point2(50.5f, 70.5f), Point2(50.5f, 300.0f)}};  // y 70 .. 74 visible
+  rasterise(partly_off, kSensor, map);
+  EXPECT_EQ(line_pixels(map), 6u + 5u);
+
+  // A shallow diagonal sampled at <= 0.25 px marks every column it crosses.
+  const std::vector<Segment> diagonal = {{Point2(0.2f, 0.7f), Point2(30.9f, 17.1f)}};
+  rasterise(diagonal, kSensor, map);
+  for (int x = 0; x <= 30; ++x) {
+    int marked = 0;
+    for (int y = 0; y < kSensor.height; ++y) marked += map[static_cast<std::size_t>(y) * kWidth + x];
+    EXPECT_GE(marked, 1) << "column " << x;
+  }
+
+  const std::vector<Segment> off_or_broken = {{Point2(-5, -5), Point2(-1, -9)},
+                                              {Point2(std::nanf(""), 3), Point2(10, 3)}};
+  rasterise(off_or_broken, kSensor, map);
+  EXPECT_EQ(line_pixels(map), 0u);
+}
+
+TEST(Prf, EmptyDenominatorsFollowTheDocumentedConvention) {
+  expect_prf(prf({}), 1, 1, 1);
+  expect_prf(prf({10, 0, 0}), 0, 1, 0);
+  expect_prf(prf({0, 10, 0}), 1, 0, 0);
+  expect_prf(prf({10, 20, 5}), 0.5, 0.25, 2 * 0.5 * 0.25 / 0.75);
+}
+
+TEST(HeatmapMatcher, ToleranceIsAFractionOfTheDiagonal) {
+  EXPECT_NEAR(HeatmapMatcher(kSensor, 0.01).tolerance_px(), 1.25, 1e-12);
+  EXPECT_NEAR(HeatmapMatcher({640, 480}, 0.02).tolerance_px(), 16.0, 1e-9);
+  EXPECT_THROW(HeatmapMatcher({0, 10}, 0.01), std::invalid_argument);
+  EXPECT_THROW(HeatmapMatcher(kSensor, -0.01), std::invalid_argument);
+  HeatmapMatcher matcher(kSensor, 0.01);
+  const std::vector<std::uint8_t> wrong_size(10, 0), right_size(100 * 75, 0);
+  EXPECT_THROW((void)matcher.match_maps(wrong_size, right_size), std::invalid_argument);
+}
+
+TEST(HeatmapMatcher, PerfectPredictionScoresOne) {
+  const std::vector<Segment> scene = {row_segment(20, 10, 50), row_segment(45, 10, 50), {Point2(5, 5), Point2(40, 70)}};
+  HeatmapMatcher matcher(kSensor, 0.01);
+  const MatchCounts counts = matcher.match(scene, scene);
+  EXPECT_EQ(counts.predicted, counts.ground_truth);
+  EXPECT_EQ(counts.matched, counts.ground_truth);
+  expect_prf(prf(counts), 1, 1, 1);
+  expect_prf(prf(matcher.match({}, {})), 1, 1, 1);
+}
+
+TEST(HeatmapMatcher, ShiftWithinToleranceMatchesAndBeyondItDoesNot) {
+  const std::vector<Segment> truth = {row_segment(20, 10, 50)};
+  HeatmapMatcher matcher(kSensor, 0.02);                        // 2.5 px
+  const std::vector<Segment> near = {row_segment(22, 10, 50)};  // 2 px away
+  expect_prf(prf(matcher.match(near, truth)), 1, 1, 1);
+  const std::vector<Segment> far = {row_segment(24, 10, 50)};  // 4 px away
+  const MatchCounts counts = matcher.match(far, truth);
+  EXPECT_EQ(counts, (MatchCounts{41, 41, 0}));
+  expect_prf(prf(counts), 0, 0, 0);
+  // Slid along itself: by 2 px every pixel still finds a partner 2 px away; by 4 px two pixels at
+  // either end have none.
+  const std::vector<Segment> slid_2 = {row_segment(20, 12, 52)}, slid_4 = {row_segment(20, 14, 54)};
+  EXPECT_EQ(matcher.match(slid_2, truth), (MatchCounts{41, 41, 41}));
+  EXPECT_EQ(matcher.match(slid_4, truth), (MatchCounts{41, 41, 39}));
+}
+
+TEST(HeatmapMatcher, MissingLineLowersRecallOnly) {
+  const std::vector<Segment> truth = {row_segment(20, 10, 50), row_segment(45, 10, 50)};
+  const std::vector<Segment> predicted = {row_segment(20, 10, 50)};
+  HeatmapMatcher matcher(kSensor, 0.01);
+  const MatchCounts counts = matcher.match(predicted, truth);
+  EXPECT_EQ(counts, (MatchCounts{41, 82, 41}));
+  expect_prf(prf(counts), 1.0, 0.5, 2.0 / 3.0);
+}
+
+TEST(HeatmapMatcher, SpuriousLineLowersPrecisionOnly) {
+  const std::vector<Segment> truth = {row_segment(20, 10, 50), row_segment(45, 10, 50)};
+  const std::vector<Segment> predicted = {row_segment(20, 10, 50), row_segment(45, 10, 50), row_segment(65, 10, 50)};
+  HeatmapMatcher matcher(kSensor, 0.01);
+  const MatchCounts counts = matcher.match(predicted, truth);
+  EXPECT_EQ(counts, (MatchCounts{123, 82, 82}));
+  expect_prf(prf(counts), 2.0 / 3.0, 1.0, 0.8);
+}
+
+TEST(HeatmapMatcher, MatchesOneToOne) {
+  const std::vector<Segment> truth = {row_segment(20, 10, 50)};
+  HeatmapMatcher matcher(kSensor, 0.01);  // 1.25 px: both predictions below lie within it
+  // Two predictions of the one line, 1 px apart: each ground-truth pixel can vouch for only one.
+  const std::vector<Segment> doubled = {row_segment(20, 10, 50), row_segment(21, 10, 50)};
+  const MatchCounts counts = matcher.match(doubled, truth);
+  EXPECT_EQ(counts, (MatchCounts{82, 41, 41}));
+  expect_prf(prf(counts), 0.5, 1.0, 2.0 / 3.0);
+  // Two identical predictions draw the same pixels: the line map keeps one of them.
+  const std::vector<Segment> identical = {row_segment(20, 10, 50), row_segment(20, 10, 50)};
+  EXPECT_EQ(matcher.match(identical, truth), (MatchCounts{41, 41, 41}));
+}
+
+TEST(HeatmapMatcher, FindsTheMaximumWhereGreedyPairingFallsShort) {
+  // Predicted a = (10, 10) comes first and takes its nearest ground truth g1 = (10, 10), although
+  // it could also take g2 = (8, 10); predicted b = (12, 10) reaches only g1. Augmenting b -> g1 -> a
+  // -> g2 matches both.
+  std::vector<std::uint8_t> predicted(kWidth * 75, 0), truth(kWidth * 75, 0);
+  predicted[10 * kWidth + 10] = 1;
+  predicted[10 * kWidth + 12] = 1;
+  truth[10 * kWidth + 10] = 1;
+  truth[10 * kWidth + 8] = 1;
+  HeatmapMatcher matcher(kSensor, 0.02);  // 2.5 px
+  EXPECT_EQ(matcher.match_maps(predicted, truth), (MatchCounts{2, 2, 2}));
+}
+
+TEST(HeatmapMatcher, HandlesEmptySidesTinySensorsAndHugeTolerances) {
+  HeatmapMatcher matcher(kSensor, 0.01);
+  const std::vector<Segment> line = {row_segment(20, 10, 50)};
+  EXPECT_EQ(matcher.match(line, {}), (MatchCounts{41, 0, 0}));
+  EXPECT_EQ(matcher.match({}, line), (MatchCounts{0, 41, 0}));
+  // A radius far beyond the sensor: every pixel reaches every other.
+  HeatmapMatcher everything({3, 2}, 10.0);
+  const std::vector<Segment> top = {{Point2(0, 0.5f), Point2(2.9f, 0.5f)}},
+                             corner = {{Point2(2.5f, 1.5f), Point2(2.5f, 1.5f)}};
+  EXPECT_EQ(everything.match(top, corner), (MatchCounts{3, 1, 1}));
+}
+
+TEST(HeatmapMatcher, RepeatedCallsGiveTheSameCounts) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> coordinate(0.0f, 75.0f);
+  std::vector<Segment> predicted, truth;
+  for (int i = 0; i < 40; ++i) {
+    predicted.push_back(
+        {Point2(coordinate(random), coordinate(random)), Point2(coordinate(random), coordinate(random))});
+    truth.push_back({Point2(coordinate(random), coordinate(random)), Point2(coordinate(random), coordinate(random))});
+  }
+  HeatmapMatcher matcher(kSensor, 0.02);
+  const MatchCounts first = matcher.match(predicted, truth);
+  EXPECT_GT(first.matched, 0u);
+  (void)matcher.match(truth, predicted);  // different sizes in between must not leak into the next call
+  EXPECT_EQ(matcher.match(predicted, truth), first);
+  EXPECT_EQ(HeatmapMatcher(kSensor, 0.02).match(predicted, truth), first);
+}
+
+// Max-cardinality (Hopcroft-Karp) against the BSDS-style min-cost assignment with outlier cost
+// 100 * tolerance. Measured over the 60 seeded cases below (64 x 48 sensor, tolerances 1%, 2% and
+// 5% of the diagonal, 58 .. 268 pixels per side, crossing and jittered segments): the counts never
+// differed (difference 0 in every case). Trading one match for shorter pairs pays only when it
+// shortens about 200 pairs by about the tolerance each, which these sizes cannot reach.
+TEST(HeatmapMatcher, AgreesWithTheMinCostReference) {
+  constexpr SensorSize sensor{64, 48};
+  std::mt19937 random(2024);
+  std::uniform_real_distribution<float> x(0.0f, 64.0f), y(0.0f, 48.0f), angle(0.0f, 6.2831853f), length(6.0f, 25.0f),
+      jitter(-2.5f, 2.5f);
+  std::uniform_int_distribution<int> count(4, 12);
+  const auto random_segment = [&]() {
+    const Point2 centre(x(random), y(random));
+    const float a = angle(random);
+    const Point2 half = 0.5f * length(random) * Point2(std::cos(a), std::sin(a));
+    return Segment{centre - half, centre + half};
+  };
+  std::uint64_t largest_difference = 0, compared = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Segment> truth, predicted;
+    const int lines = count(random);
+    for (int i = 0; i < lines; ++i) {
+      const Segment s = random_segment();
+      truth.push_back(s);
+      // A jittered copy of most lines, and some spurious ones.
+      if (i % 3 != 2) {
+        predicted.push_back(
+            {s.q0 + Point2(jitter(random), jitter(random)), s.q1 + Point2(jitter(random), jitter(random))});
+      }
+      if (i % 2 == 0) predicted.push_back(random_segment());
+    }
+    for (const double fraction : {0.01, 0.02, 0.05}) {
+      HeatmapMatcher matcher(sensor, fraction);
+      const MatchCounts counts = matcher.match(predicted, truth);
+      if (counts.predicted > kReferenceMaxPixels || counts.ground_truth > kReferenceMaxPixels) continue;
+      const std::uint64_t reference = min_cost_matched_count_reference(sensor, fraction, predicted, truth);
+      EXPECT_LE(reference, counts.matched) << "trial " << trial << " fraction " << fraction;
+      largest_difference = std::max(largest_difference, counts.matched - reference);
+      ++compared;
+    }
+  }
+  EXPECT_GE(compared, 50u);
+  EXPECT_EQ(largest_difference, 0u);
+  // A low outlier cost makes the assignment drop far pairs, which max-cardinality keeps.
+  const std::vector<Segment> truth = {row_segment(10, 5, 40)};
+  const std::vector<Segment> shifted = {row_segment(12, 5, 40)};
+  EXPECT_EQ(HeatmapMatcher(sensor, 0.05).match(shifted, truth).matched, 36u);
+  EXPECT_EQ(min_cost_matched_count_reference(sensor, 0.05, shifted, truth, 0.2), 0u);  // pair 2 px > 2 * 0.8 px
+}
+
+TEST(EvaluationAccumulator, SumsCountsOverSteps) {
+  EvaluationAccumulator accumulator;  // 1% and 2%
+  ASSERT_EQ(accumulator.tolerance_fractions().size(), 2u);
+  expect_prf(accumulator.summed_prf(0), 1, 1, 1);
+  const std::vector<MatchCounts> first = {{100, 80, 60}, {100, 80, 70}};
+  const std::vector<MatchCounts> second = {{50, 70, 40}, {50, 70, 50}};
+  accumulator.add_step(first, 10, 8);
+  accumulator.add_step(second, 5, 7);
+  EXPECT_EQ(accumulator.steps(), 2u);
+  EXPECT_EQ(accumulator.total(0), (MatchCounts{150, 150, 100}));
+  EXPECT_EQ(accumulator.total(1), (MatchCounts{150, 150, 120}));
+  expect_prf(accumulator.summed_prf(0), 2.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0);
+  expect_prf(accumulator.summed_prf(1), 0.8, 0.8, 0.8);
+  ASSERT_EQ(accumulator.step_prf(0).size(), 2u);
+  EXPECT_DOUBLE_EQ(accumulator.step_prf(0)[1].precision, 0.8);
+  // Mean of steps: precision (0.6 + 0.8) / 2, recall (0.75 + 4/7) / 2.
+  const Prf mean = accumulator.mean_step_prf(0);
+  EXPECT_DOUBLE_EQ(mean.precision, 0.7);
+  EXPECT_DOUBLE_EQ(mean.recall, (0.75 + 4.0 / 7.0) / 2.0);
+  EXPECT_DOUBLE_EQ(mean.f, (prf(first[0]).f + prf(second[0]).f) / 2.0);
+  EXPECT_DOUBLE_EQ(accumulator.mean_predicted_segments(), 7.5);
+  EXPECT_DOUBLE_EQ(accumulator.mean_ground_truth_segments(), 7.5);
+  EXPECT_THROW(accumulator.add_step(std::span(first).first(1), 1, 1), std::invalid_argument);
+  EXPECT_THROW(EvaluationAccumulator(std::vector<double>{}), std::invalid_argument);
+}
+
+TEST(EvaluationAccumulator, TakesMatcherResults) {
+  EvaluationAccumulator accumulator({0.01, 0.02});
+  HeatmapMatcher tight(kSensor, 0.01), loose(kSensor, 0.02);
+  const std::vector<Segment> truth = {row_segment(20, 10, 50), row_segment(45, 10, 50)};
+  const std::vector<Segment> predicted = {row_segment(22, 10, 50)};  // 2 px off: only the loose tolerance
+  const std::vector<Segment> perfect = truth;
+  for (const auto& step : {predicted, perfect}) {
+    const MatchCounts counts[2] = {tight.match(step, truth), loose.match(step, truth)};
+    accumulator.add_step(counts, step.size(), truth.size());
+  }
+  EXPECT_EQ(accumulator.total(0), (MatchCounts{123, 164, 82}));
+  EXPECT_EQ(accumulator.total(1), (MatchCounts{123, 164, 123}));
+  EXPECT_DOUBLE_EQ(accumulator.mean_predicted_segments(), 1.5);
+}
+
+TEST(LifetimeTracker, StatsAndHistogram) {
+  LifetimeTracker tracker;
+  EXPECT_EQ(tracker.summary().count, 0u);
+  EXPECT_TRUE(tracker.histogram(10).empty());
+  const std::vector<std::uint64_t> first_step = {1, 3};
+  tracker.observe_step(80'000, first_step);  // id 3 first seen late: order does not matter
+  tracker.observe(0, 1);
+  tracker.observe(10'000, 1);
+  tracker.observe(5'000, 2);  // seen once: lives 0 ms
+  tracker.observe(20'000, 3);
+  tracker.observe(30'000, 1);
+  tracker.observe(80'000, 1);  // id 1: 0 .. 80 ms
+  const std::vector<IdLifetime> lifetimes = tracker.lifetimes();
+  ASSERT_EQ(lifetimes.size(), 3u);
+  EXPECT_EQ(lifetimes[0].id, 1u);
+  EXPECT_DOUBLE_EQ(lifetimes[0].lifetime_ms(), 80.0);
+  EXPECT_DOUBLE_EQ(lifetimes[1].lifetime_ms(), 0.0);
+  EXPECT_EQ(lifetimes[2].first_us, 20'000);
+  EXPECT_DOUBLE_EQ(lifetimes[2].lifetime_ms(), 60.0);
+
+  const LifetimeSummary summary = tracker.summary();
+  EXPECT_EQ(summary.count, 3u);
+  EXPECT_DOUBLE_EQ(summary.mean_ms, 140.0 / 3.0);
+  const double mean = 140.0 / 3.0;
+  EXPECT_NEAR(summary.std_ms, std::sqrt(((80 - mean) * (80 - mean) + mean * mean + (60 - mean) * (60 - mean)) / 3.0),
+              1e-12);
+  EXPECT_DOUBLE_EQ(summary.max_ms, 80.0);
+
+  EXPECT_EQ(tracker.histogram(25.0), (std::vector<std::uint64_t>{1, 0, 1, 1}));     // 0 | - | 60 | 80
+  EXPECT_EQ(tracker.histogram(20.0), (std::vector<std::uint64_t>{1, 0, 0, 1, 1}));  // 80 opens bin 4
+  EXPECT_THROW((void)tracker.histogram(0.0), std::invalid_argument);
+  EXPECT_THROW((void)tracker.histogram(1e-9), std::length_error);
+}
+
+class PlotFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = std::filesystem::temp_directory_path() /
+                 ("evldt_eval_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    std::filesystem::create_directories(directory_);
+  }
+  void TearDown() override { std::filesystem::remove_all(directory_); }
+
+  static void expect_chart(const std::filesystem::path& path) {
+    const cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+    ASSERT_FALSE(image.empty()) << path;
+    EXPECT_EQ(image.cols, kPlotWidth);
+    EXPECT_EQ(image.rows, kPlotHeight);
+    EXPECT_LT(cv::mean(image)[0], 255.0);  // something was drawn
+  }
+
+  std::filesystem::path directory_;
+};
+
+TEST_F(PlotFiles, PrCurveIsAReadablePng) {
+  const std::vector<PrPoint> points = {{0.5, 0.9, 0.4, 0.0}, {0.1, 0.5, 0.85, 0.0}, {0.3, 0.75, 0.7, 0.0}};
+  std::vector<PrPoint> with_f = points;
+  for (PrPoint& p : with_f) p.f = 2 * p.precision * p.recall / (p.precision + p.recall);
+  write_pr_curve_png(directory_ / "pr.png", with_f, "precision / recall at 1%");
+  expect_chart(directory_ / "pr.png");
+  write_pr_curve_png(directory_ / "empty.png", {}, "no points");
+  expect_chart(directory_ / "empty.png");
+}
+
+TEST_F(PlotFiles, HistogramIsAReadablePng) {
+  write_histogram_png(directory_ / "histogram.png", {4, 9, 2, 0, 1}, 20.0, "lifetimes");
+  expect_chart(directory_ / "histogram.png");
+  write_histogram_png(directory_ / "many.png", std::vector<std::uint64_t>(2000, 3), 0.5, "many bins");
+  expect_chart(directory_ / "many.png");
+  write_histogram_png(directory_ / "empty.png", {}, 1.0, "nothing");
+  expect_chart(directory_ / "empty.png");
+  EXPECT_THROW(write_histogram_png(directory_ / "bad.png", {1}, 0.0, "bad"), std::invalid_argument);
+}
+
+TEST_F(PlotFiles, WriteFailureNamesThePath) {
+  const std::filesystem::path missing = directory_ / "no_such_dir" / "chart.png";
+  try {
+    write_histogram_png(missing, {1, 2}, 1.0, "x");
+    FAIL() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(missing.string()), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(write_pr_curve_png(missing, {}, "x"), std::runtime_error);
+}
+
+TEST(JsonWriter, WritesNestedValuesWithEscaping) {
+  std::ostringstream out;
+  JsonWriter json(out);
+  json.begin_object()
+      .field("name", "a \"quoted\"\\ line\n\x01")
+      .field("steps", 3)
+      .field("big", std::uint64_t{18446744073709551615u})
+      .field("f", 0.1)
+      .field("nan", std::nan(""))
+      .field("ok", true);
+  json.key("list").begin_array().value(-2).value(0.5).begin_object().end_object().end_array();
+  json.key("empty").begin_array().end_array();
+  json.end_object();
+  EXPECT_TRUE(json.done());
+  EXPECT_EQ(out.str(),
+            "{\n"
+            "  \"name\": \"a \\\"quoted\\\"\\\\ line\\n\\u0001\",\n"
+            "  \"steps\": 3,\n"
+            "  \"big\": 18446744073709551615,\n"
+            "  \"f\": 0.1,\n"
+            "  \"nan\": null,\n"
+            "  \"ok\": true,\n"
+            "  \"list\": [\n"
+            "    -2,\n"
+            "    0.5,\n"
+            "    {}\n"
+            "  ],\n"
+            "  \"empty\": []\n"
+            "}\n");
+  JsonWriter misuse(out);
+  misuse.begin_object();
+  EXPECT_THROW(misuse.value(1), std::logic_error);
+  EXPECT_THROW(misuse.end_array(), std::logic_error);
+}
+
+}  // namespace
+}  // namespace evldt

@@ -1,0 +1,613 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "evldt/events/event_decoder.hpp"
+#include "evldt/events/event_reader.hpp"
+#include "evldt/events/event_writer.hpp"
+
+namespace evldt {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr Timestamp k2Pow24 = Timestamp{1} << 24;
+constexpr Timestamp k2Pow32 = Timestamp{1} << 32;
+constexpr std::size_t kOneMiB = std::size_t{1} << 20;
+const SensorSize kSensor{1280, 720};
+
+/// A scratch directory with a unique name, removed with everything in it at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    const auto unique = std::to_string(std::random_device{}()) + "-" +
+                        std::to_string(std::chrono::steady_clock::now().time_since_epoch().count());
+    path_ = fs::temp_directory_path() / ("evldt-test-formats-" + unique);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  [[nodiscard]] fs::path file(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
+
+std::vector<Event> events_of(const EventBatch& batch) {
+  std::vector<Event> events;
+  for (std::size_t i = 0; i < batch.size(); ++i) events.push_back(batch[i]);
+  return events;
+}
+
+EventBatch batch_of(const std::vector<Event>& events) {
+  EventBatch batch;
+  for (const Event& e : events) batch.push_back(e);
+  return batch;
+}
+
+/// Seeded random events in time order. Small steps (often 0) cross the 2^24 us EVT 3.0 wrap; three jumps of
+/// 1.5e9 us (below the 2^31 us that dat can step) take the time past 2^32 us.
+std::vector<Event> random_events(std::size_t count) {
+  std::mt19937_64 random(20240611);
+  std::uniform_int_distribution<int> step_us(0, 40);
+  std::uniform_int_distribution<int> x(0, kSensor.width - 1);
+  std::uniform_int_distribution<int> y(0, kSensor.height - 1);
+  std::bernoulli_distribution on(0.5);
+  std::vector<Event> events;
+  Timestamp t = k2Pow24 - 3000;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (i > 0 && i % (count / 4) == 0) t += 1'500'000'000;
+    t += step_us(random);
+    events.push_back({t, static_cast<std::uint16_t>(x(random)), static_cast<std::uint16_t>(y(random)),
+                      on(random) ? std::int8_t{1} : std::int8_t{-1}});
+  }
+  return events;
+}
+
+void write_file(const fs::path& path, EventFormat format, const std::vector<Event>& events, std::size_t batches = 3) {
+  EventWriter writer(path, format, kSensor);
+  const std::size_t per_batch = (events.size() + batches - 1) / batches;
+  for (std::size_t start = 0; start < events.size(); start += per_batch) {
+    const auto end = std::min(events.size(), start + per_batch);
+    writer.write(batch_of({events.begin() + static_cast<std::ptrdiff_t>(start), events.begin() + static_cast<std::ptrdiff_t>(end)}));
+  }
+  writer.close();
+}
+
+void write_bytes(const fs::path& path, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream file(path, std::ios::binary);
+  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::vector<std::uint8_t> read_bytes(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+std::vector<std::uint8_t> bytes_of(const std::string& text) { return {text.begin(), text.end()}; }
+
+void append_le16(std::vector<std::uint8_t>& bytes, std::uint16_t word) {
+  bytes.push_back(static_cast<std::uint8_t>(word));
+  bytes.push_back(static_cast<std::uint8_t>(word >> 8));
+}
+
+void append_le32(std::vector<std::uint8_t>& bytes, std::uint32_t word) {
+  for (int shift = 0; shift < 32; shift += 8) bytes.push_back(static_cast<std::uint8_t>(word >> shift));
+}
+
+struct ReadResult {
+  std::vector<Event> events;
+  std::optional<FormatError> error;
+  bool ended_after_error = false;
+};
+
+/// Reads the whole file through EventFileReader, stopping at the first FormatError.
+ReadResult read_file(const fs::path& path, std::optional<EventFormat> format, std::size_t chunk_bytes) {
+  EventFileReader reader(path, format, chunk_bytes);
+  ReadResult result;
+  EventBatch batch;
+  try {
+    while (reader.read(batch)) {
+      EXPECT_FALSE(batch.empty());
+      const auto events = events_of(batch);
+      result.events.insert(result.events.end(), events.begin(), events.end());
+    }
+    EXPECT_EQ(reader.bytes_read(), reader.file_size());
+  } catch (const FormatError& error) {
+    result.error = error;
+    result.ended_after_error = !reader.read(batch);
+  }
+  return result;
+}
+
+/// Feeds the bytes to a decoder `chunk_bytes` at a time, then finishes.
+std::vector<Event> decode_in_chunks(EventFormat format, const std::vector<std::uint8_t>& bytes, std::size_t chunk_bytes,
+                                    std::optional<SensorSize>* geometry = nullptr) {
+  const auto decoder = make_decoder(format, "memory");
+  EventBatch batch;
+  for (std::size_t start = 0; start < bytes.size(); start += chunk_bytes) {
+    decoder->decode(std::span(bytes).subspan(start, std::min(chunk_bytes, bytes.size() - start)), batch);
+  }
+  decoder->finish(batch);
+  if (geometry != nullptr) *geometry = decoder->geometry();
+  return events_of(batch);
+}
+
+/// Runs `decode` expecting a FormatError; returns it.
+template <class Decode>
+FormatError expect_format_error(Decode&& decode) {
+  try {
+    decode();
+  } catch (const FormatError& error) {
+    return error;
+  }
+  ADD_FAILURE() << "no FormatError";
+  return FormatError("", 0, "none");
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Names
+
+TEST(EventFormat, ParsesNamesAndPrintsThemBack) {
+  for (const EventFormat format : {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Dat}) {
+    EXPECT_EQ(parse_event_format(format_name(format)), format);
+  }
+  EXPECT_EQ(parse_event_format("evt3"), EventFormat::Evt3);
+  EXPECT_EQ(parse_event_format("ecd"), EventFormat::EcdText);
+  EXPECT_FALSE(parse_event_format("evt21"));
+  EXPECT_FALSE(parse_event_format(""));
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Round trips through files
+
+struct FormatCase {
+  EventFormat format;
+  const char* file_name;
+};
+
+class RoundTrip : public ::testing::TestWithParam<FormatCase> {};
+
+TEST_P(RoundTrip, ReadsBackExactlyWhatWasWrittenWhateverTheChunkSize) {
+  TempDir dir;
+  const auto [format, file_name] = GetParam();
+  const fs::path path = dir.file(file_name);
+  const std::vector<Event> written = random_events(4000);
+  ASSERT_LT(written.front().t, k2Pow24);
+  ASSERT_GT(written.back().t, k2Pow32);
+  write_file(path, format, written);
+
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, kOneMiB}) {
+    SCOPED_TRACE("chunk " + std::to_string(chunk));
+    EventFileReader reader(path, std::nullopt, chunk);  // the format is guessed from the name (and header)
+    EXPECT_EQ(reader.format(), format);
+    if (format == EventFormat::EcdText) {
+      EXPECT_FALSE(reader.geometry());
+    } else {
+      EXPECT_EQ(reader.geometry(), kSensor);
+    }
+    const ReadResult result = read_file(path, std::nullopt, chunk);
+    EXPECT_FALSE(result.error) << result.error->what();
+    EXPECT_EQ(result.events, written);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryFormat, RoundTrip,
+                         ::testing::Values(FormatCase{EventFormat::EcdText, "events.txt"},
+                                           FormatCase{EventFormat::Evt2, "events_evt2.raw"},
+                                           FormatCase{EventFormat::Evt3, "events.raw"},
+                                           FormatCase{EventFormat::Dat, "events.dat"}),
+                         [](const auto& test_info) { return std::string(format_name(test_info.param.format)); });
+
+TEST(RoundTripEdges, EvtFormatsCrossLongGapsAndTheirOwnWraps) {
+  // Gaps of hours: EVT 3.0 steps its 24-bit time high across 512 wraps, EVT 2.0 crosses its 2^34 us wrap.
+  const std::vector<Event> written{{0, 1, 2, 1},
+                                   {5, 2047, 0, -1},
+                                   {(Timestamp{1} << 33) + 5, 3, 4, 1},
+                                   {(Timestamp{1} << 34) + 100, 5, 6, -1},
+                                   {(Timestamp{1} << 34) + 100, 7, 8, 1}};
+  TempDir dir;
+  for (const EventFormat format : {EventFormat::Evt2, EventFormat::Evt3, EventFormat::EcdText}) {
+    SCOPED_TRACE(std::string(format_name(format)));
+    const fs::path path = dir.file("gaps.bin");
+    write_file(path, format, written);
+    EXPECT_EQ(read_file(path, format, 7).events, written);
+  }
+}
+
+TEST(RoundTripEdges, EmptyRecordingHasHeaderOnly) {
+  TempDir dir;
+  for (const EventFormat format : {EventFormat::Evt2, EventFormat::Evt3, EventFormat::Dat, EventFormat::EcdText}) {
+    SCOPED_TRACE(std::string(format_name(format)));
+    const fs::path path = dir.file("empty.bin");
+    write_file(path, format, {});
+    const ReadResult result = read_file(path, format, 3);
+    EXPECT_FALSE(result.error);
+    EXPECT_TRUE(result.events.empty());
+    if (format != EventFormat::EcdText) {
+      EXPECT_EQ(EventFileReader(path, format).geometry(), kSensor);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Headers
+
+TEST(Header, GeometryComesFromAnyOfTheHeaderForms) {
+  std::optional<SensorSize> geometry;
+  decode_in_chunks(EventFormat::Evt3, bytes_of("% camera_integrator_name Prophesee\n% format EVT3;height=720;width=1280\n% end\n"), 5,
+                   &geometry);
+  EXPECT_EQ(geometry, (SensorSize{1280, 720}));
+
+  decode_in_chunks(EventFormat::Evt2, bytes_of("% evt 2.0\r\n% geometry 640x480\r\n"), 4, &geometry);
+  EXPECT_EQ(geometry, (SensorSize{640, 480}));
+
+  auto dat = bytes_of("% Data file containing CD events\n% Version 2\n% Width 304\n% Height 240\n");
+  dat.insert(dat.end(), {0x0C, 0x08});
+  decode_in_chunks(EventFormat::Dat, dat, 1, &geometry);
+  EXPECT_EQ(geometry, (SensorSize{304, 240}));
+
+  decode_in_chunks(EventFormat::Evt3, bytes_of("% evt 3.0\n% end\n"), 64, &geometry);
+  EXPECT_FALSE(geometry);
+  decode_in_chunks(EventFormat::EcdText, bytes_of("0.5 1 2 1\n"), 64, &geometry);
+  EXPECT_FALSE(geometry);
+}
+
+TEST(Header, WriterHeaderNamesEncodingAndGeometry) {
+  TempDir dir;
+  const fs::path path = dir.file("header.raw");
+  write_file(path, EventFormat::Evt3, {});
+  const auto bytes = read_bytes(path);
+  EXPECT_EQ(std::string(bytes.begin(), bytes.end()), "% evt 3.0\n% format EVT3;height=720;width=1280\n% geometry 1280x720\n% end\n");
+}
+
+TEST(Header, RawFileFormatIsTakenFromTheHeaderOrRefused) {
+  TempDir dir;
+  const fs::path path = dir.file("recording.raw");
+  auto bytes = bytes_of("% format EVT2;height=480;width=640\n% end\n");
+  append_le32(bytes, 0x10000000u | (3u << 11) | 4u);  // CD_ON at x=3 y=4, t=0
+  write_bytes(path, bytes);
+  EXPECT_EQ(EventFileReader(path).format(), EventFormat::Evt2);
+  EXPECT_EQ(read_file(path, std::nullopt, kOneMiB).events, (std::vector<Event>{{0, 3, 4, 1}}));
+
+  write_bytes(path, bytes_of("% camera something\n% end\n"));
+  const FormatError no_version = expect_format_error([&] { EventFileReader reader(path); });
+  EXPECT_EQ(no_version.byte_offset(), 0u);
+  EXPECT_NE(std::string(no_version.what()).find(path.string()), std::string::npos);
+
+  write_bytes(path, bytes_of("% format EVT21;height=480;width=640\n% end\n"));
+  EXPECT_THROW(EventFileReader reader(path), FormatError);
+}
+
+TEST(Header, DecoderRefusesDataTheHeaderSaysIsAnotherEncoding) {
+  const FormatError error =
+      expect_format_error([] { decode_in_chunks(EventFormat::Evt3, bytes_of("% evt 2.0\n% end\n"), 64); });
+  EXPECT_NE(std::string(error.what()).find("EVT2"), std::string::npos);
+}
+
+TEST(Header, UnterminatedHeaderLineIsTruncation) {
+  const auto bytes = bytes_of("% evt 3.0\n% format EVT3;hei");
+  const FormatError error = expect_format_error([&] { decode_in_chunks(EventFormat::Evt3, bytes, 4); });
+  EXPECT_EQ(error.byte_offset(), 10u);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Hand-written EVT 2.0 / EVT 3.0 words
+
+TEST(Evt2, DecodesHandWrittenWords) {
+  auto bytes = bytes_of("% evt 2.0\n% end\n");
+  append_le32(bytes, (0x1u << 28) | (5u << 22) | (100u << 11) | 200u);  // CD_ON before any TIME_HIGH: time high 0
+  append_le32(bytes, (0x8u << 28) | 3u);                                // TIME_HIGH: time 3 * 64
+  append_le32(bytes, (0x0u << 28) | (7u << 22) | (1u << 11) | 2u);      // CD_OFF
+  append_le32(bytes, (0xAu << 28) | 0x12345u);                          // EXT_TRIGGER: skipped
+  append_le32(bytes, (0xEu << 28) | 0x1u);                              // OTHERS: skipped
+  append_le32(bytes, (0xFu << 28) | 0x7u);                              // CONTINUED: skipped
+  append_le32(bytes, (0x8u << 28) | 0x0FFFFFFFu);                       // last TIME_HIGH before the 2^34 us wrap
+  append_le32(bytes, (0x1u << 28) | (63u << 22) | (2047u << 11) | 2047u);
+  append_le32(bytes, (0x8u << 28) | 1u);                                // wrapped
+  append_le32(bytes, (0x0u << 28) | (9u << 22) | (10u << 11) | 11u);
+  const std::vector<Event> expected{{5, 100, 200, 1},
+                                    {3 * 64 + 7, 1, 2, -1},
+                                    {Timestamp{0x0FFFFFFF} * 64 + 63, 2047, 2047, 1},
+                                    {((Timestamp{1} << 28) + 1) * 64 + 9, 10, 11, -1}};
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{3}, bytes.size()}) {
+    EXPECT_EQ(decode_in_chunks(EventFormat::Evt2, bytes, chunk), expected) << "chunk " << chunk;
+  }
+}
+
+TEST(Evt3, DecodesHandWrittenWordsWithVectorsAndTimeWrap) {
+  std::vector<std::uint8_t> bytes;  // no header: the data may start right away
+  append_le16(bytes, 0x2805);  // EVT_ADDR_X before any time: dropped
+  append_le16(bytes, 0x8001);  // TIME_HIGH 1 -> 4096 us
+  append_le16(bytes, 0x6010);  // TIME_LOW 16 -> 4112 us
+  append_le16(bytes, 0x000A);  // EVT_ADDR_Y 10
+  append_le16(bytes, 0x2805);  // EVT_ADDR_X polarity 1, x 5
+  append_le16(bytes, 0x3064);  // VECT_BASE_X polarity 0, x 100
+  append_le16(bytes, 0x4805);  // VECT_12 bits 0, 2, 11 -> x 100, 102, 111; base -> 112
+  append_le16(bytes, 0x5081);  // VECT_8 bits 0, 7 -> x 112, 119; base -> 120
+  append_le16(bytes, 0x7123);  // CONTINUED_4, EXT_TRIGGER, OTHERS, CONTINUED_12: skipped
+  append_le16(bytes, 0xA001);
+  append_le16(bytes, 0xE014);
+  append_le16(bytes, 0xF456);
+  append_le16(bytes, 0x5002);  // VECT_8 bit 1 -> x 121
+  append_le16(bytes, 0x8FFF);  // TIME_HIGH 0xFFF
+  append_le16(bytes, 0x6005);  // TIME_LOW 5
+  append_le16(bytes, 0x2007);  // EVT_ADDR_X polarity 0, x 7
+  append_le16(bytes, 0x8002);  // TIME_HIGH 2: went back, so the 24-bit time base wrapped
+  append_le16(bytes, 0x6003);  // TIME_LOW 3
+  append_le16(bytes, 0x0014);  // EVT_ADDR_Y 20
+  append_le16(bytes, 0x2801);  // EVT_ADDR_X polarity 1, x 1
+  const Timestamp before_wrap = (Timestamp{0xFFF} << 12) + 5;
+  const Timestamp after_wrap = k2Pow24 + (Timestamp{2} << 12) + 3;
+  const std::vector<Event> expected{{4112, 5, 10, 1},    {4112, 100, 10, -1}, {4112, 102, 10, -1},
+                                    {4112, 111, 10, -1}, {4112, 112, 10, -1}, {4112, 119, 10, -1},
+                                    {4112, 121, 10, -1}, {before_wrap, 7, 10, -1}, {after_wrap, 1, 20, 1}};
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{3}, bytes.size()}) {
+    EXPECT_EQ(decode_in_chunks(EventFormat::Evt3, bytes, chunk), expected) << "chunk " << chunk;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// ECD text
+
+TEST(EcdText, ConvertsDecimalSecondsToExactMicroseconds) {
+  const std::string text =
+      "# t x y p\n"
+      "0.0000015 1 2 1\n"    // 1.5 us rounds half up
+      "0.0000014999 1 2 1\r\n"
+      "\n"
+      "12.5 3 4 0\n"
+      "1 0 0 1\n"
+      "0.003811000 5 6 0\n"
+      "0.9999995 7 8 1\n"   // the rounding carries into the seconds
+      "   \t\n"
+      "4294.967296123 65535 65535 0\n"
+      "2.000001\t9  10 1";  // last line without '\n'
+  const std::vector<Event> expected{{2, 1, 2, 1},         {1, 1, 2, 1},        {12'500'000, 3, 4, -1},
+                                    {1'000'000, 0, 0, 1}, {3811, 5, 6, -1},    {1'000'000, 7, 8, 1},
+                                    {4'294'967'296, 65535, 65535, -1}, {2'000'001, 9, 10, 1}};
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, text.size()}) {
+    EXPECT_EQ(decode_in_chunks(EventFormat::EcdText, bytes_of(text), chunk), expected) << "chunk " << chunk;
+  }
+}
+
+TEST(EcdText, WriterPrintsSecondsWithNineFractionDigits) {
+  TempDir dir;
+  const fs::path path = dir.file("events.txt");
+  write_file(path, EventFormat::EcdText, {{3811, 5, 6, -1}, {12'500'000, 640, 480, 1}, {k2Pow32, 0, 0, 1}}, 1);
+  const auto bytes = read_bytes(path);
+  EXPECT_EQ(std::string(bytes.begin(), bytes.end()), "0.003811000 5 6 0\n12.500000000 640 480 1\n4294.967296000 0 0 1\n");
+}
+
+TEST(EcdText, MalformedLinesAreReportedAtTheirStartWithTheirNumber) {
+  const std::string good = "0.1 1 2 1\n";  // 10 bytes
+  for (const std::string bad : {"0.2 abc 3 0", "0.2 1 2", "0.2 1 2 2", "0.2 -1 2 1", "0.2 1 65536 1", "0.2 1 2 1 junk",
+                                "-0.2 1 2 1", "0.2e3 1 2 1", "0.2. 1 2 1", ". 1 2 1", "0,2 1 2 1"}) {
+    SCOPED_TRACE(bad);
+    EventBatch batch;
+    const auto decoder = make_decoder(EventFormat::EcdText, "events.txt");
+    const FormatError error = expect_format_error([&] { decoder->decode(bytes_of(good + bad + "\n0.3 1 1 1\n"), batch); });
+    EXPECT_EQ(events_of(batch), (std::vector<Event>{{100000, 1, 2, 1}}));
+    EXPECT_EQ(error.byte_offset(), good.size());
+    EXPECT_NE(std::string(error.what()).find("line 2"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("events.txt"), std::string::npos) << error.what();
+  }
+}
+
+TEST(EcdText, GarbageLineInAFileDeliversTheEventsBeforeIt) {
+  TempDir dir;
+  const fs::path path = dir.file("garbage.txt");
+  write_bytes(path, bytes_of("0.1 1 2 1\n0.2 3 4 0\n\x01\x02garbage\n0.3 5 6 1\n"));
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, kOneMiB}) {
+    const ReadResult result = read_file(path, std::nullopt, chunk);
+    EXPECT_EQ(result.events, (std::vector<Event>{{100000, 1, 2, 1}, {200000, 3, 4, -1}}));
+    ASSERT_TRUE(result.error);
+    EXPECT_EQ(result.error->byte_offset(), 20u);
+    EXPECT_NE(std::string(result.error->what()).find("line 3"), std::string::npos);
+    EXPECT_TRUE(result.ended_after_error);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Corrupt and truncated files
+
+class Truncated : public ::testing::TestWithParam<FormatCase> {};
+
+TEST_P(Truncated, DeliversEveryEventBeforeTheCutThenReportsItsOffset) {
+  TempDir dir;
+  const auto [format, file_name] = GetParam();
+  const fs::path path = dir.file(file_name);
+  const std::vector<Event> written = random_events(400);
+  write_file(path, format, written);
+  auto bytes = read_bytes(path);
+
+  // Cut the file inside its last record / word / line: that last event is lost, and the error points at
+  // where the partial data starts.
+  std::uint64_t partial_start = 0;
+  switch (format) {
+    case EventFormat::EcdText:
+      partial_start = std::string(bytes.begin(), bytes.end()).rfind('\n', bytes.size() - 2) + 1;
+      bytes.resize(bytes.size() - 3);  // drops " p\n": the line ends after y
+      break;
+    case EventFormat::Evt2: partial_start = bytes.size() - 4; bytes.resize(bytes.size() - 1); break;
+    case EventFormat::Evt3: partial_start = bytes.size() - 2; bytes.resize(bytes.size() - 1); break;
+    case EventFormat::Dat: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 5); break;
+  }
+  write_bytes(path, bytes);
+  const std::vector<Event> before_cut(written.begin(), written.end() - 1);
+
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, kOneMiB}) {
+    SCOPED_TRACE("chunk " + std::to_string(chunk));
+    const ReadResult result = read_file(path, std::nullopt, chunk);
+    EXPECT_EQ(result.events, before_cut);
+    ASSERT_TRUE(result.error);
+    EXPECT_EQ(result.error->byte_offset(), partial_start);
+    EXPECT_EQ(result.error->source(), path.string());
+    EXPECT_NE(std::string(result.error->what()).find(path.string()), std::string::npos) << result.error->what();
+    EXPECT_TRUE(result.ended_after_error);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryFormat, Truncated,
+                         ::testing::Values(FormatCase{EventFormat::EcdText, "events.txt"},
+                                           FormatCase{EventFormat::Evt2, "events_evt2.raw"},
+                                           FormatCase{EventFormat::Evt3, "events.raw"},
+                                           FormatCase{EventFormat::Dat, "events.dat"}),
+                         [](const auto& test_info) { return std::string(format_name(test_info.param.format)); });
+
+TEST(Corrupt, DatCutInTheMiddleKeepsTheWholeRecordsBeforeIt) {
+  TempDir dir;
+  const fs::path path = dir.file("cut.dat");
+  const std::vector<Event> written = random_events(100);
+  write_file(path, EventFormat::Dat, written);
+  auto bytes = read_bytes(path);
+  const std::size_t data_start = bytes.size() - 8 * written.size();
+  bytes.resize(data_start + 8 * 37 + 3);
+  write_bytes(path, bytes);
+
+  const ReadResult result = read_file(path, std::nullopt, 7);
+  EXPECT_EQ(result.events, std::vector<Event>(written.begin(), written.begin() + 37));
+  ASSERT_TRUE(result.error);
+  EXPECT_EQ(result.error->byte_offset(), data_start + 8 * 37);
+}
+
+TEST(Corrupt, ReservedEvt2TypeIsAnErrorAtItsWord) {
+  auto bytes = bytes_of("% evt 2.0\n% end\n");  // 16 bytes
+  append_le32(bytes, (0x1u << 28) | (1u << 11) | 1u);
+  append_le32(bytes, 0x20000000u);  // type 0x2 is reserved
+  append_le32(bytes, (0x1u << 28) | (2u << 11) | 2u);
+  EventBatch batch;
+  const auto decoder = make_decoder(EventFormat::Evt2, "cam.raw");
+  const FormatError error = expect_format_error([&] { decoder->decode(bytes, batch); });
+  EXPECT_EQ(events_of(batch), (std::vector<Event>{{0, 1, 1, 1}}));
+  EXPECT_EQ(error.byte_offset(), 20u);
+  EXPECT_NE(std::string(error.what()).find("reserved"), std::string::npos);
+}
+
+TEST(Corrupt, ReservedEvt3TypesAreErrorsThatTheReaderDeliversAfterTheEvents) {
+  TempDir dir;
+  const fs::path path = dir.file("reserved.raw");
+  for (const std::uint16_t reserved : std::initializer_list<std::uint16_t>{0x1000, 0x9000, 0xB000, 0xC000, 0xD000}) {
+    SCOPED_TRACE(reserved);
+    auto bytes = bytes_of("% evt 3.0\n% end\n");  // 16 bytes
+    for (const std::uint16_t word : {std::uint16_t{0x8000}, std::uint16_t{0x0003}, std::uint16_t{0x2804}, reserved,
+                                     std::uint16_t{0x2805}}) {
+      append_le16(bytes, word);
+    }
+    write_bytes(path, bytes);
+    const ReadResult result = read_file(path, std::nullopt, 3);
+    EXPECT_EQ(result.events, (std::vector<Event>{{0, 4, 3, 1}}));
+    ASSERT_TRUE(result.error);
+    EXPECT_EQ(result.error->byte_offset(), 22u);
+    EXPECT_TRUE(result.ended_after_error);
+  }
+}
+
+TEST(Corrupt, DatWithWrongEventSizeOrTypeIsRefused) {
+  TempDir dir;
+  const fs::path path = dir.file("wrong.dat");
+  const std::string header = "% Version 2\n% Width 640\n% Height 480\n";
+  auto bytes = bytes_of(header);
+  bytes.insert(bytes.end(), {0x0C, 0x10});
+  append_le32(bytes, 10);
+  append_le32(bytes, 1);
+  write_bytes(path, bytes);
+  const ReadResult wrong_size = read_file(path, std::nullopt, kOneMiB);
+  EXPECT_TRUE(wrong_size.events.empty());
+  ASSERT_TRUE(wrong_size.error);
+  EXPECT_EQ(wrong_size.error->byte_offset(), header.size() + 1);
+  EXPECT_NE(std::string(wrong_size.error->what()).find("event size"), std::string::npos);
+
+  bytes[header.size()] = 0x0E;  // external triggers, not CD events
+  bytes[header.size() + 1] = 8;
+  write_bytes(path, bytes);
+  const ReadResult wrong_type = read_file(path, std::nullopt, kOneMiB);
+  ASSERT_TRUE(wrong_type.error);
+  EXPECT_EQ(wrong_type.error->byte_offset(), header.size());
+}
+
+TEST(Corrupt, DatTimesUnwrapPast32Bits) {
+  auto bytes = bytes_of("% Width 640\n% Height 480\n");
+  bytes.insert(bytes.end(), {0x0C, 0x08});
+  for (const std::uint32_t t : {0xFFFFFFF0u, 0x00000010u, 0x7FFFFFFFu}) {
+    append_le32(bytes, t);
+    append_le32(bytes, 1u | (2u << 14) | (1u << 28));
+  }
+  const std::vector<Event> expected{{0xFFFFFFF0, 1, 2, 1}, {k2Pow32 + 0x10, 1, 2, 1}, {k2Pow32 + 0x7FFFFFFF, 1, 2, 1}};
+  EXPECT_EQ(decode_in_chunks(EventFormat::Dat, bytes, 5), expected);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Opening and writing
+
+TEST(Reader, MissingFileIsARuntimeErrorNamingThePath) {
+  TempDir dir;
+  const fs::path path = dir.file("does-not-exist.raw");
+  try {
+    EventFileReader reader(path);
+    FAIL() << "opened a missing file";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
+  }
+}
+
+TEST(Reader, UnknownExtensionNeedsAnExplicitFormat) {
+  TempDir dir;
+  const fs::path path = dir.file("events.bin");
+  write_file(path, EventFormat::Dat, {{1, 2, 3, 1}});
+  EXPECT_THROW(EventFileReader reader(path), std::runtime_error);
+  EXPECT_EQ(read_file(path, EventFormat::Dat, kOneMiB).events, (std::vector<Event>{{1, 2, 3, 1}}));
+}
+
+TEST(Writer, RejectsTimeGoingBackwardsAndKeepsWhatWasWritten) {
+  TempDir dir;
+  for (const EventFormat format : {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Dat}) {
+    SCOPED_TRACE(std::string(format_name(format)));
+    const fs::path path = dir.file("backwards.bin");
+    EventWriter writer(path, format, kSensor);
+    writer.write(batch_of({{100, 1, 1, 1}, {100, 2, 2, -1}}));
+    EXPECT_THROW(writer.write(batch_of({{150, 1, 1, 1}, {120, 1, 1, 1}})), std::invalid_argument);  // within a batch
+    EXPECT_THROW(writer.write(batch_of({{99, 1, 1, 1}})), std::invalid_argument);                  // across batches
+    EXPECT_THROW(writer.write(batch_of({{-1, 1, 1, 1}})), std::invalid_argument);
+    writer.write(batch_of({{101, 3, 3, 1}}));
+    writer.close();
+    EXPECT_EQ(read_file(path, format, kOneMiB).events, (std::vector<Event>{{100, 1, 1, 1}, {100, 2, 2, -1}, {101, 3, 3, 1}}));
+  }
+}
+
+TEST(Writer, RejectsWhatTheFormatCannotHold) {
+  TempDir dir;
+  const fs::path path = dir.file("limits.bin");
+  EXPECT_THROW(EventWriter(path, EventFormat::Evt3, SensorSize{4096, 64}), std::invalid_argument);
+  EventWriter evt3(path, EventFormat::Evt3, SensorSize{2048, 2048});
+  EXPECT_THROW(evt3.write(batch_of({{1, 2048, 0, 1}})), std::invalid_argument);
+  EventWriter dat(path, EventFormat::Dat, kSensor);
+  EXPECT_THROW(dat.write(batch_of({{0, 1, 1, 1}, {Timestamp{1} << 31, 1, 1, 1}})), std::invalid_argument);
+}
+
+TEST(Writer, UnwritablePathIsARuntimeErrorNamingIt) {
+  TempDir dir;
+  const fs::path path = dir.file("no-such-dir") / "events.raw";
+  try {
+    EventWriter writer(path, EventFormat::Evt3, kSensor);
+    FAIL() << "created a file in a missing directory";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace evldt

@@ -1,0 +1,149 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "evldt/lines/deterministic_pipeline.hpp"
+#include "evldt/lines/realtime_engine.hpp"
+#include "support/sweeping_edge.hpp"
+
+namespace evldt {
+namespace {
+
+constexpr SensorSize kSensor{240, 180};
+
+bool on_lattice_line(float coordinate, int block_size) {
+  const float k = (coordinate - static_cast<float>(block_size / 2)) / static_cast<float>(block_size);
+  return std::abs(k - std::round(k)) * static_cast<float>(block_size) < 1e-3f;
+}
+
+// A vertical edge sweeping right at 200 px/s from x = 30 to x = 90 over 0.3 s. Its ends lie on block
+// borders (y = 20 and 164): an end inside a block leaves a square blob of events there, which can
+// score as a short line of the wrong orientation (measured by the accuracy benchmark, not here).
+EventBatch vertical_sweep() {
+  return testing::sweep_events({Point2(30, 20), Point2(30, 164), Point2(200, 0), 0, 300000}, kSensor);
+}
+
+struct Observation {
+  Timestamp t;
+  TrackedLine line;
+};
+
+std::vector<Observation> run(const EventBatch& events, const PipelineConfig& config, Timestamp step_us) {
+  DeterministicPipeline pipeline(config);
+  std::vector<Observation> seen;
+  pipeline.set_output(step_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
+    for (const TrackedLine& line : lines.lines()) seen.push_back({t, line});
+  });
+  pipeline.process(events);
+  return seen;
+}
+
+TEST(Pipeline, DetectsASweepingEdgeOnBlockBordersAndTracksItWithStableIds) {
+  const PipelineConfig config = default_config_for(kSensor);
+  ASSERT_EQ(config.lattice.block_size, 8);
+  const auto seen = run(vertical_sweep(), config, 10000);
+  ASSERT_FALSE(seen.empty());
+
+  std::map<std::uint64_t, std::set<int>> columns_by_id;  // admin block columns each id has lived in
+  const LatticeGeometry g = LatticeGeometry::make(kSensor, 8, 1.0);
+  for (const Observation& o : seen) {
+    const Segment& s = o.line.segment;
+    // Each endpoint lies on a lattice line.
+    EXPECT_TRUE(on_lattice_line(s.q0.x(), 8) || on_lattice_line(s.q0.y(), 8)) << s.q0.transpose();
+    EXPECT_TRUE(on_lattice_line(s.q1.x(), 8) || on_lattice_line(s.q1.y(), 8)) << s.q1.transpose();
+    // The segment follows the true edge x = 30 + 200 t, and is near vertical. The lattice holds the
+    // last two pixel columns the edge crossed and a line moves at most dq = 0.8 px per 2 ms round, so
+    // it trails the edge by one to three pixels.
+    const float edge_x = 30.0f + 200.0f * static_cast<float>(o.t) * 1e-6f;
+    const float lag = edge_x - s.centre().x();
+    EXPECT_GE(lag, -0.5f) << "t=" << o.t << " id=" << o.line.id;
+    EXPECT_LE(lag, 3.0f) << "t=" << o.t << " id=" << o.line.id;
+    EXPECT_LT(std::abs(s.q1.x() - s.q0.x()), 0.3f * std::abs(s.q1.y() - s.q0.y()));
+    // It is administered by the block under its centre's row.
+    EXPECT_EQ(g.row(o.line.admin_block), g.row(g.block_at(s.centre().x(), s.centre().y())));
+    columns_by_id[o.line.id].insert(g.column(o.line.admin_block));
+  }
+  // The 144 px edge spans 18 block rows and is seen in each, by one line per row at a time.
+  std::map<Timestamp, std::multiset<int>> rows_at;
+  for (const Observation& o : seen) rows_at[o.t].insert(g.row(o.line.admin_block));
+  const auto& last = rows_at.rbegin()->second;
+  EXPECT_GE(last.size(), 16u);
+  for (const int row : last) EXPECT_EQ(last.count(row), 1u) << "two lines in block row " << row;
+  // Lines keep their id while the edge crosses several block columns (60 px = 7.5 blocks).
+  std::size_t long_lived = 0;
+  for (const auto& [id, columns] : columns_by_id) long_lived += columns.size() >= 5 ? 1 : 0;
+  EXPECT_GE(long_lived, 10u);
+}
+
+TEST(Pipeline, TwoRunsAreIdentical) {
+  const PipelineConfig config = default_config_for(kSensor);
+  const auto events = vertical_sweep();
+  const auto a = run(events, config, 5000);
+  const auto b = run(events, config, 5000);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].t, b[i].t);
+    EXPECT_EQ(a[i].line.id, b[i].line.id);
+    EXPECT_EQ(a[i].line.segment.q0, b[i].line.segment.q0);
+    EXPECT_EQ(a[i].line.segment.q1, b[i].line.segment.q1);
+    EXPECT_EQ(a[i].line.score, b[i].line.score);
+  }
+}
+
+TEST(Pipeline, RoundsRunOnEventTimeAndLongGapsAreSkipped) {
+  PipelineConfig config = default_config_for(kSensor);
+  config.schedule.track_period_us = 1000;
+  config.schedule.detect_period_us = 2000;
+  DeterministicPipeline pipeline(config);
+  std::vector<Timestamp> steps;
+  pipeline.set_output(1000, [&](Timestamp t, const LineMap&, const ScarfLattice&) { steps.push_back(t); });
+  EventBatch batch;
+  batch.push_back(0, 50, 50, 1);
+  batch.push_back(4500, 50, 50, 1);        // rounds at 1000..4000
+  batch.push_back(3600000000, 50, 50, 1);  // an hour later: only the rounds of the last 8 periods run
+  pipeline.process(batch);
+  EXPECT_EQ(pipeline.counters().events, 3u);
+  EXPECT_EQ(pipeline.counters().track_rounds, 4u + 9u);   // t - 8000 .. t inclusive
+  EXPECT_EQ(pipeline.counters().detect_rounds, 2u + 5u);
+  EXPECT_EQ(steps.size(), 4u + 9u);
+  EXPECT_EQ(steps[3], 4000);
+  EXPECT_EQ(steps[4], 3600000000 - 8000);
+  EXPECT_GT(pipeline.counters().skipped_rounds, 3000000u);
+}
+
+TEST(RealtimeEngine, FindsTheSweepingEdgeOnItsOwnThreads) {
+  const PipelineConfig config = default_config_for(kSensor);
+  RealtimeEngine engine(config);
+  engine.set_first_line_id(1000);
+  engine.start();
+  const EventBatch events = vertical_sweep();
+  EventBatch chunk;
+  // Feed in 2 ms slices, letting the loops run between them as a live camera would.
+  std::size_t i = 0;
+  for (Timestamp slice_end = 2000; i < events.size(); slice_end += 2000) {
+    chunk.clear();
+    for (; i < events.size() && events.t[i] < slice_end; ++i) chunk.push_back(events[i]);
+    engine.process(chunk);
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  std::vector<TrackedLine> lines;
+  for (int attempt = 0; attempt < 200 && lines.size() < 10; ++attempt) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    engine.snapshot(lines);
+  }
+  engine.stop();
+  const auto counters = engine.counters();
+  EXPECT_EQ(counters.events, events.size());
+  EXPECT_GT(counters.detect_rounds, 0u);
+  EXPECT_GT(counters.track_rounds, 0u);
+  ASSERT_GE(lines.size(), 10u);
+  for (const TrackedLine& line : lines) {
+    EXPECT_GE(line.id, 1000u);
+    EXPECT_NEAR(line.segment.centre().x(), 90.0f, 3.0f);
+  }
+}
+
+}  // namespace
+}  // namespace evldt

@@ -1,0 +1,148 @@
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "evldt/scarf/scarf_lattice.hpp"
+#include "support/sweeping_edge.hpp"
+
+namespace evldt {
+namespace {
+
+constexpr SensorSize kSensor{64, 48};  // b = 8: 7 x 5 blocks, lattice from 4 to 60 (x) and 4 to 44 (y)
+
+TEST(LatticeGeometry, TilesWithHalfBlockMargin) {
+  const auto g = LatticeGeometry::make(kSensor, 8, 1.0);
+  EXPECT_EQ(g.blocks_x, 7);
+  EXPECT_EQ(g.blocks_y, 5);
+  EXPECT_EQ(g.capacity, 32);
+  EXPECT_EQ(g.min_points(), 3);
+  EXPECT_EQ(g.block_at(4.0f, 4.0f), g.index(0, 0));
+  EXPECT_EQ(g.block_at(3.99f, 10.0f), -1);
+  EXPECT_EQ(g.block_at(59.99f, 43.99f), g.index(6, 4));
+  EXPECT_EQ(g.block_at(60.0f, 20.0f), -1);
+  EXPECT_EQ(LatticeGeometry::make({640, 480}, 14, 1.0).capacity, 98);
+  EXPECT_EQ(LatticeGeometry::make({640, 480}, 14, 0.5).capacity, 49);
+}
+
+TEST(LatticeGeometry, RejectsUnusableParameters) {
+  EXPECT_THROW(LatticeGeometry::make({0, 48}, 8, 1.0), std::invalid_argument);
+  EXPECT_THROW(LatticeGeometry::make({64, 48}, 7, 1.0), std::invalid_argument);
+  EXPECT_THROW(LatticeGeometry::make({64, 48}, 64, 1.0), std::invalid_argument);
+  EXPECT_THROW(LatticeGeometry::make({64, 48}, 8, -1.0), std::invalid_argument);
+  EXPECT_THROW(LatticeGeometry::make({64, 48}, 8, std::nan("")), std::invalid_argument);
+  EXPECT_THROW(LatticeGeometry::make({40000, 48}, 8, 1.0), std::invalid_argument);
+}
+
+// Which blocks got an entry for a pixel, and with which flag.
+std::set<std::pair<int, bool>> blocks_written(std::uint16_t x, std::uint16_t y) {
+  ScarfLattice lattice(kSensor, 8, 1.0);
+  lattice.insert(x, y);
+  std::set<std::pair<int, bool>> written;
+  for (int block = 0; block < lattice.geometry().block_count(); ++block) {
+    for (const LatticeEntry& e : lattice.entries(block)) {
+      EXPECT_EQ(e.x, x);
+      EXPECT_EQ(e.y(), y);
+      written.insert({block, e.active()});
+    }
+  }
+  return written;
+}
+
+TEST(ScarfLattice, ActiveInHomeBlockInactiveInThreeQuadrantNeighbours) {
+  const auto g = LatticeGeometry::make(kSensor, 8, 1.0);
+  // Pixel 13 is in block column 1 ([12, 20)), left half -> column 0; pixel 21 in row 2 ([20, 28)), top half -> row 1.
+  const std::set<std::pair<int, bool>> expected{
+      {g.index(1, 2), true}, {g.index(0, 2), false}, {g.index(1, 1), false}, {g.index(0, 1), false}};
+  EXPECT_EQ(blocks_written(13, 21), expected);
+  // Right/bottom halves pick the other side.
+  const std::set<std::pair<int, bool>> expected_other{
+      {g.index(1, 2), true}, {g.index(2, 2), false}, {g.index(1, 3), false}, {g.index(2, 3), false}};
+  EXPECT_EQ(blocks_written(17, 25), expected_other);
+}
+
+TEST(ScarfLattice, MarginPixelsAreOnlyInactive) {
+  const auto g = LatticeGeometry::make(kSensor, 8, 1.0);
+  // Top-left margin corner pixel: inside block (0,0)'s extended region only.
+  EXPECT_EQ(blocks_written(1, 2), (std::set<std::pair<int, bool>>{{g.index(0, 0), false}}));
+  // Left margin, row 2 bottom half: blocks (0,2) and (0,3), inactive.
+  EXPECT_EQ(blocks_written(0, 26), (std::set<std::pair<int, bool>>{{g.index(0, 2), false}, {g.index(0, 3), false}}));
+  // Lattice edge column: the last block has no right neighbour.
+  EXPECT_EQ(blocks_written(59, 30),
+            (std::set<std::pair<int, bool>>{{g.index(6, 3), true}, {g.index(6, 2), false}}));
+  // The last row of this sensor is still inside row 4's extended band.
+  EXPECT_EQ(blocks_written(30, 47), (std::set<std::pair<int, bool>>{{g.index(3, 4), false}, {g.index(2, 4), false}}));
+  // On a 70 px wide sensor the right margin is 10 px: its outer pixels belong to no block.
+  ScarfLattice wide({70, 48}, 8, 1.0);
+  wide.insert(66, 20);
+  for (int block = 0; block < wide.geometry().block_count(); ++block) EXPECT_TRUE(wide.entries(block).empty());
+}
+
+TEST(ScarfLattice, RingKeepsNewestNAndCountsActive) {
+  ScarfLattice lattice(kSensor, 8, 1.0, /*keep_surface=*/true);
+  const auto& g = lattice.geometry();
+  const int block = g.index(3, 2);
+  for (int k = 0; k < 40; ++k) lattice.insert(static_cast<std::uint16_t>(30 + k % 2), 22);  // 40 active events
+  EXPECT_EQ(lattice.entries(block).size(), 32u);
+  EXPECT_EQ(lattice.active_count(block), 32);
+  EXPECT_EQ(lattice.surface()[22 * 64 + 30] + lattice.surface()[22 * 64 + 31], 32);
+  // Inactive writes from the neighbour below push the active ones out one by one.
+  for (int k = 0; k < 10; ++k) lattice.insert(30, 28);  // row 3, top half -> inactive in row 2
+  EXPECT_EQ(lattice.active_count(block), 22);
+  EXPECT_EQ(lattice.surface()[22 * 64 + 30] + lattice.surface()[22 * 64 + 31], 22);
+  EXPECT_EQ(lattice.surface()[28 * 64 + 30], 10);  // active in its own block (3,3)
+}
+
+TEST(ScarfLattice, CopyStateGivesAnIdenticalView) {
+  ScarfLattice source(kSensor, 8, 1.0), copy(kSensor, 8, 1.0);
+  for (int k = 0; k < 500; ++k) source.insert(static_cast<std::uint16_t>(k * 7 % 64), static_cast<std::uint16_t>(k * 5 % 48));
+  copy.copy_state_from(source);
+  for (int block = 0; block < source.geometry().block_count(); ++block) {
+    ASSERT_EQ(copy.active_count(block), source.active_count(block));
+    const auto a = source.entries(block), b = copy.entries(block);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].y_and_flag, b[i].y_and_flag);
+  }
+  ScarfLattice other(SensorSize{64, 64}, 8, 1.0);
+  EXPECT_THROW(other.copy_state_from(source), std::invalid_argument);
+}
+
+// An edge crossing the sensor at speed v leaves (per block it has passed) the same active entries
+// whatever v: the ring holds a fixed number of events, not a time window.
+TEST(ScarfLattice, ActiveEntriesPerBlockDoNotDependOnEdgeSpeed) {
+  const SensorSize sensor{240, 180};
+  auto active_per_block = [&](float speed) {
+    ScarfLattice lattice(sensor, 8, 1.0);
+    // Vertical edge from x=20 moving right; stop when it has reached x=100.
+    const float seconds = 80.0f / speed;
+    const auto events = testing::sweep_events(
+        {Point2(20, 0), Point2(20, 180), Point2(speed, 0), 0, static_cast<Timestamp>(seconds * 1e6)}, sensor);
+    lattice.insert(events);
+    std::vector<int> counts;
+    for (int block = 0; block < lattice.geometry().block_count(); ++block) counts.push_back(lattice.active_count(block));
+    return counts;
+  };
+  const auto slow = active_per_block(100.0f);
+  const auto fast = active_per_block(1000.0f);
+  EXPECT_EQ(slow, fast);
+  // Behind the edge, inactive entries have cleared the blocks: only the 21 blocks of its column hold it.
+  int touched = 0;
+  for (const int c : slow) touched += c > 0 ? 1 : 0;
+  EXPECT_EQ(touched, 21);
+}
+
+TEST(ScarfLattice, InactiveEntriesClearABlockAfterTheEdgeLeaves) {
+  const SensorSize sensor{240, 180};
+  ScarfLattice lattice(sensor, 8, 1.0);
+  const auto& g = lattice.geometry();
+  const int block = g.index(5, 10);  // x in [44, 52)
+  // Edge sweeps from x=30 through the block and stops at x=56: 4 px past it, inside the half-block band.
+  lattice.insert(testing::sweep_events({Point2(30, 0), Point2(30, 180), Point2(100, 0), 0, 260000}, sensor));
+  EXPECT_EQ(lattice.active_count(block), 0);
+  // Stopping inside the block leaves its active entries.
+  ScarfLattice inside(sensor, 8, 1.0);
+  inside.insert(testing::sweep_events({Point2(30, 0), Point2(30, 180), Point2(100, 0), 0, 200000}, sensor));
+  EXPECT_GT(inside.active_count(block), g.min_points());
+}
+
+}  // namespace
+}  // namespace evldt

@@ -1,0 +1,164 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "evldt/scarf/scarf_lattice.hpp"
+#include "evldt/sim/event_simulator.hpp"
+#include "evldt/sim/scenes.hpp"
+
+namespace evldt {
+namespace {
+
+// One dark vertical bar [x0, x0 + 20] x [-10, 190] on a bright background, moving right at `speed`.
+Scene moving_bar(double speed_px_s, Timestamp duration_us, double x0 = 60) {
+  Scene s{"bar", {240, 180}, 0.8, {}, {}, duration_us};
+  Shape bar;
+  bar.polygon = {{x0, -10}, {x0 + 20, -10}, {x0 + 20, 190}, {x0, 190}};
+  bar.brightness = 0.2;
+  bar.motion.tx = {0, speed_px_s, 0, 0, 0};
+  s.shapes.push_back(bar);
+  return s;
+}
+
+EventBatch simulate(const Scene& scene, const SimulatorConfig& config, SimulatorCounters* counters = nullptr,
+                    Timestamp slice_us = 7000) {
+  EventSimulator simulator(scene, config);
+  EventBatch all;
+  while (simulator.run_until(simulator.now_us() + slice_us, all)) {
+  }
+  if (counters) *counters = simulator.counters();
+  return all;
+}
+
+SimulatorConfig quiet_config() {
+  SimulatorConfig c;
+  c.noise_rate_hz = 0;
+  c.refractory_us = 0;
+  return c;
+}
+
+TEST(EventSimulator, SameSeedSameEventsOtherSeedOthers) {
+  const Scene scene = make_scene("boxes-6dof");
+  SimulatorConfig config;
+  config.seed = 7;
+  Scene short_scene = scene;
+  short_scene.duration_us = 300000;
+  const EventBatch a = simulate(short_scene, config), b = simulate(short_scene, config);
+  ASSERT_GT(a.size(), 1000u);
+  EXPECT_EQ(a.t, b.t);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.p, b.p);
+  // Asking in other slices does not change the events.
+  const EventBatch sliced = simulate(short_scene, config, nullptr, 1234);
+  EXPECT_EQ(a.t, sliced.t);
+  EXPECT_EQ(a.x, sliced.x);
+  config.seed = 8;
+  const EventBatch c = simulate(short_scene, config);
+  EXPECT_NE(a.t, c.t);
+}
+
+TEST(EventSimulator, EventsAreTimeOrderedAndOnTheSensor) {
+  Scene scene = make_scene("circle-board");
+  scene.duration_us = 200000;
+  const EventBatch events = simulate(scene, SimulatorConfig{});
+  ASSERT_GT(events.size(), 1000u);
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    ASSERT_LT(events.x[i], 640);
+    ASSERT_LT(events.y[i], 480);
+    ASSERT_TRUE(events.p[i] == 1 || events.p[i] == -1);
+    if (i > 0) {
+      ASSERT_LE(events.t[i - 1], events.t[i]);
+    }
+  }
+  EXPECT_LE(events.t.back(), 200000);
+}
+
+TEST(EventSimulator, StaticSceneGivesOnlyNoise) {
+  SimulatorConfig config;
+  config.noise_rate_hz = 2.0;  // 240 * 180 * 2 = 86400 ev/s
+  SimulatorCounters counters;
+  const EventBatch events = simulate(moving_bar(0.0, 500000), config, &counters);
+  EXPECT_EQ(counters.signal_events, 0u);
+  EXPECT_EQ(counters.noise_events, events.size());
+  EXPECT_NEAR(static_cast<double>(events.size()), 43200.0, 5 * std::sqrt(43200.0));
+}
+
+TEST(EventSimulator, EventsLieOnTheMovingEdges) {
+  const double speed = 150;
+  const EventBatch events = simulate(moving_bar(speed, 200000), quiet_config());
+  ASSERT_GT(events.size(), 5000u);
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const double left = 60 + speed * static_cast<double>(events.t[i]) * 1e-6;
+    const double centre = events.x[i] + 0.5;
+    const double distance = std::min(std::abs(centre - left), std::abs(centre - (left + 20)));
+    ASSERT_LT(distance, 1.0) << "event " << i << " at x=" << events.x[i] << " t=" << events.t[i];
+    // The leading (right) edge darkens pixels, the trailing one brightens them.
+    ASSERT_EQ(events.p[i], std::abs(centre - left) < std::abs(centre - (left + 20)) ? 1 : -1);
+  }
+}
+
+TEST(EventSimulator, DoubleSpeedDoublesTheRateButNotTheScarfCount) {
+  // Same 60 px of travel: the fast bar takes half the time.
+  const EventBatch slow = simulate(moving_bar(150, 400000), quiet_config());
+  const EventBatch fast = simulate(moving_bar(300, 200000), quiet_config());
+  const double slow_rate = static_cast<double>(slow.size()) / 0.4, fast_rate = static_cast<double>(fast.size()) / 0.2;
+  EXPECT_NEAR(fast_rate / slow_rate, 2.0, 0.2);
+  auto active_entries = [](const EventBatch& events) {
+    ScarfLattice lattice({240, 180}, 8, 1.0);
+    lattice.insert(events);
+    long total = 0;
+    for (int block = 0; block < lattice.geometry().block_count(); ++block) total += lattice.active_count(block);
+    return total;
+  };
+  const long slow_active = active_entries(slow), fast_active = active_entries(fast);
+  ASSERT_GT(slow_active, 500);
+  EXPECT_NEAR(static_cast<double>(fast_active) / static_cast<double>(slow_active), 1.0, 0.1);
+}
+
+TEST(Scene, VisibleEdgesAreClippedToTheSensorAndByOccluders) {
+  Scene s{"occlusion", {100, 80}, 0.5, {}, {}, 1000};
+  Shape wall;
+  wall.polygon = {{-20, 20}, {120, 20}, {120, 60}, {-20, 60}};  // wider than the sensor
+  Shape square;
+  square.polygon = {{40, 10}, {60, 10}, {60, 30}, {40, 30}};  // over the wall's top edge (y = 20)
+  square.brightness = 0.1;
+  Shape disc;
+  disc.polygon = {{70, 50}, {90, 50}, {90, 70}, {70, 70}};
+  disc.straight_edges = false;  // a curved occluder: no ground truth of its own
+  s.shapes = {wall, square, disc};
+  const auto edges = s.visible_edges(0);
+  // Wall top: [0, 40] and [60, 100]; wall bottom: [0, 70] and [90, 100]; square: 4 edges; nothing of the disc.
+  std::vector<std::pair<double, double>> wall_top, wall_bottom;
+  int square_edges = 0;
+  for (const GtSegment& e : edges) {
+    ASSERT_NE(e.gt_id / 64, 2);
+    if (e.gt_id == 0) wall_top.push_back({std::min(e.a.x(), e.b.x()), std::max(e.a.x(), e.b.x())});
+    if (e.gt_id == 2) wall_bottom.push_back({std::min(e.a.x(), e.b.x()), std::max(e.a.x(), e.b.x())});
+    if (e.gt_id / 64 == 1) ++square_edges;
+  }
+  std::sort(wall_top.begin(), wall_top.end());
+  std::sort(wall_bottom.begin(), wall_bottom.end());
+  ASSERT_EQ(wall_top.size(), 2u);
+  EXPECT_NEAR(wall_top[0].first, 0, 1e-9);
+  EXPECT_NEAR(wall_top[0].second, 40, 1e-9);
+  EXPECT_NEAR(wall_top[1].first, 60, 1e-9);
+  EXPECT_NEAR(wall_top[1].second, 100, 1e-9);
+  ASSERT_EQ(wall_bottom.size(), 2u);
+  EXPECT_NEAR(wall_bottom[0].second, 70, 1e-9);
+  EXPECT_NEAR(wall_bottom[1].first, 90, 1e-9);
+  EXPECT_EQ(square_edges, 4);
+}
+
+TEST(Scenes, EveryBuiltInSceneIsValid) {
+  for (const auto& name : scene_names()) {
+    const Scene s = make_scene(name);
+    EXPECT_EQ(s.name, name);
+    EXPECT_TRUE(s.sensor.valid());
+    EXPECT_FALSE(s.visible_edges(0).empty()) << name;
+  }
+  EXPECT_THROW(make_scene("no-such-scene"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace evldt
