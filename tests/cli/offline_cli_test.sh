@@ -7,11 +7,12 @@ tools=$1
 src=$2
 sim=$tools/evldt-sim/evldt-sim
 offline=$tools/evldt-offline/evldt-offline
+eval=$tools/evldt-eval/evldt-eval
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-for bin in "$sim" "$offline"; do
+for bin in "$sim" "$offline" "$eval"; do
   "$bin" --help >"$work/help" || fail "$bin --help exit status"
   grep -q "Usage" "$work/help" || fail "$bin --help text"
   if "$bin" --no-such-flag >"$work/out" 2>&1; then fail "$bin accepted an unknown flag"; fi
@@ -62,4 +63,17 @@ echo "ok: truncated recording -> exit 2, $(grep -o 'byte [0-9]*' "$work/cut_err.
 ls "$work/frames"/frame_*.png >/dev/null 2>&1 || fail "no frames rendered"
 grep -q '"lines_created"' "$work/s.json" || fail "summary JSON"
 echo "ok: PNG frames and JSON summary"
-echo "offline CLI: 6 passed, 0 failed"
+
+# Evaluation: the ground truth scored against itself is perfect; a file run and an in-process run agree.
+awk -F, 'NR == 1 { print "t_us,id,x0,y0,x1,y1,score,status"; next } { print $1 "," $2 "," $3 "," $4 "," $5 "," $6 ",1.0,good" }' \
+  "$work/rec/ground_truth.csv" >"$work/gt_as_pred.csv"
+"$eval" --segments "$work/gt_as_pred.csv" --ground-truth "$work/rec/ground_truth.csv" --width 240 --height 180 \
+  --json "$work/self.json" >"$work/self.txt"
+grep -Eq '^gt_as_pred.csv +0.000 +1.000 +1.000 +1.000 +1.000 +1.000 +1.000' "$work/self.txt" || fail "self-evaluation: $(cat "$work/self.txt")"
+"$offline" "$work/rec/events.raw" -o "$work/p.csv" -q >/dev/null
+"$eval" --segments "$work/p.csv" --scene boxes-6dof --duration-s 0.4 | tail -1 | awk '{ $1 = ""; $2 = ""; print }' >"$work/from_file.txt"
+"$eval" --scene boxes-6dof --duration-s 0.4 --log-level warn --lifetime-png "$work/life.png" | tail -1 | awk '{ $1 = ""; $2 = ""; print }' >"$work/in_process.txt"
+cmp -s "$work/from_file.txt" "$work/in_process.txt" || fail "file and in-process evaluation differ: $(cat "$work/from_file.txt") vs $(cat "$work/in_process.txt")"
+[[ -s "$work/life.png" ]] || fail "no lifetime histogram"
+echo "ok: evaluation of ground truth against itself is perfect; file and in-process scores agree: $(cat "$work/in_process.txt")"
+echo "offline CLI: 8 passed, 0 failed"

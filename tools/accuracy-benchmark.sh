@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Accuracy benchmark: every built-in scene through the deterministic pipeline and the evaluator with
+# the default parameters; one table (line heat-map P/R/F at 1% and 2% of the diagonal, segments per
+# step, ids, lifetimes, event rate). Usage: tools/accuracy-benchmark.sh [BUILD_DIR] [OUT_DIR]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$root/build/release}
+out=${2:-$root/out/accuracy}
+eval=$build/tools/evldt-eval/evldt-eval
+[[ -x "$eval" ]] || { echo "build first: cmake --build $build (missing $eval)" >&2; exit 1; }
+mkdir -p "$out"
+printed_header=0
+for scene in three-lines-fast circle-board boxes-6dof multi-speed monitor-hd; do
+  step=10000
+  [[ $scene == monitor-hd ]] && step=20000  # 1280x720: score every 20 ms to keep the run short
+  "$eval" --scene "$scene" --step-us "$step" --log-level warn --json "$out/$scene.json" \
+    --lifetime-png "$out/$scene-lifetimes.png" >"$out/$scene.txt"
+  if ((printed_header == 0)); then head -1 "$out/$scene.txt"; printed_header=1; fi
+  rate=$(python3 -c "import json; r = json.load(open('$out/$scene.json'))['runs'][0]; print(f\"{r['events'] / r['scene_seconds'] / 1e6:.2f}\")")
+  echo "$(tail -1 "$out/$scene.txt")   ${rate} Mev/s"
+done
+echo "per-scene JSON and lifetime histograms in $out"

@@ -1,0 +1,217 @@
+// evldt-eval: line heat-map precision / recall / F and lifetimes of predicted segments against
+// ground truth, from files or by running the pipeline on a built-in scene (also over thresholds).
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <spdlog/spdlog.h>
+
+#include "evldt/app/pipeline_options.hpp"
+#include "evldt/app/simulator_options.hpp"
+#include "evldt/eval/json.hpp"
+#include "evldt/eval/plots.hpp"
+#include "evldt/eval/scene_evaluation.hpp"
+#include "evldt/lines/segment_csv.hpp"
+#include "evldt/sim/ground_truth_csv.hpp"
+
+namespace {
+
+using namespace evldt;
+
+struct Options {
+  std::filesystem::path segments, ground_truth, json, pr_png, lifetime_png;
+  std::vector<double> tolerances{0.01, 0.02};
+  std::vector<float> pr_thresholds;
+  Timestamp step_us = 10000;
+  double histogram_bin_ms = 50;
+  std::string log_level = "info";
+};
+
+struct Report {
+  std::string label;
+  float threshold = 0;
+  std::vector<Prf> summed;
+  double mean_predicted = 0, mean_ground_truth = 0;
+  std::uint64_t steps = 0;
+  LifetimeSummary lifetime;
+  std::uint64_t events = 0;
+  double scene_seconds = 0, wall_seconds = 0;
+};
+
+Report make_report(const StepEvaluator& evaluator) {
+  Report r;
+  const auto& a = evaluator.accuracy();
+  for (std::size_t i = 0; i < a.tolerance_fractions().size(); ++i) r.summed.push_back(a.summed_prf(i));
+  r.mean_predicted = a.mean_predicted_segments();
+  r.mean_ground_truth = a.mean_ground_truth_segments();
+  r.steps = a.steps();
+  r.lifetime = evaluator.lifetimes().summary();
+  return r;
+}
+
+// Predictions and ground truth read from CSV files; ground truth of a step is the latest GT row time <= t.
+StepEvaluator evaluate_files(const Options& options, SensorSize sensor, const SimulatorOptions& sim) {
+  const auto rows = read_segment_csv(options.segments);
+  std::map<Timestamp, std::vector<Segment>> gt_by_time;
+  if (!options.ground_truth.empty()) {
+    for (const auto& g : read_ground_truth_csv(options.ground_truth)) {
+      gt_by_time[g.t_us].push_back({g.segment.a.cast<float>(), g.segment.b.cast<float>()});
+    }
+  }
+  const std::optional<Scene> scene = sim.scene_selected() ? std::optional<Scene>(sim.scene()) : std::nullopt;
+  StepEvaluator evaluator(sensor, options.tolerances);
+  std::vector<std::uint64_t> ids;
+  std::vector<Segment> predicted;
+  const std::vector<Segment> none;
+  for (std::size_t i = 0; i < rows.size();) {
+    const Timestamp t = rows[i].t_us;
+    ids.clear();
+    predicted.clear();
+    for (; i < rows.size() && rows[i].t_us == t; ++i) {
+      ids.push_back(rows[i].id);
+      predicted.push_back(rows[i].segment);
+    }
+    if (scene) {
+      evaluator.add_step(t, ids, predicted, scene_ground_truth(*scene, t));
+    } else {
+      auto it = gt_by_time.upper_bound(t);
+      evaluator.add_step(t, ids, predicted, it == gt_by_time.begin() ? none : std::prev(it)->second);
+    }
+  }
+  return evaluator;
+}
+
+void print_table(const std::vector<Report>& reports, const Options& options) {
+  std::printf("%-24s %6s", "run", "f_th");
+  for (const double tol : options.tolerances) std::printf("   P@%.0f%%   R@%.0f%%   F@%.0f%%", tol * 100, tol * 100, tol * 100);
+  std::printf("  segs/step  gt/step  ids  life_mean_ms life_max_ms\n");
+  for (const Report& r : reports) {
+    std::printf("%-24s %6.3f", r.label.c_str(), static_cast<double>(r.threshold));
+    for (const Prf& p : r.summed) std::printf("  %6.3f  %6.3f  %6.3f", p.precision, p.recall, p.f);
+    std::printf("  %9.1f  %7.1f  %4llu  %11.1f %11.1f\n", r.mean_predicted, r.mean_ground_truth,
+                static_cast<unsigned long long>(r.lifetime.count), r.lifetime.mean_ms, r.lifetime.max_ms);
+  }
+}
+
+void write_json(const std::vector<Report>& reports, const Options& options) {
+  std::ofstream out(options.json);
+  if (!out) throw std::runtime_error("cannot create " + options.json.string());
+  JsonWriter json(out);
+  json.begin_object().key("runs").begin_array();
+  for (const Report& r : reports) {
+    json.begin_object().key("run").value(r.label).key("fit_threshold").value(static_cast<double>(r.threshold));
+    json.key("steps").value(r.steps).key("events").value(r.events).key("scene_seconds").value(r.scene_seconds);
+    json.key("wall_seconds").value(r.wall_seconds);
+    json.key("accuracy").begin_array();
+    for (std::size_t i = 0; i < r.summed.size(); ++i) {
+      json.begin_object().key("tolerance").value(options.tolerances[i]).key("precision").value(r.summed[i].precision);
+      json.key("recall").value(r.summed[i].recall).key("f").value(r.summed[i].f).end_object();
+    }
+    json.end_array();
+    json.key("mean_segments_per_step").value(r.mean_predicted).key("mean_gt_segments_per_step").value(r.mean_ground_truth);
+    json.key("lifetime").begin_object().key("ids").value(r.lifetime.count).key("mean_ms").value(r.lifetime.mean_ms);
+    json.key("std_ms").value(r.lifetime.std_ms).key("max_ms").value(r.lifetime.max_ms).end_object();
+    json.end_object();
+  }
+  json.end_array().end_object();
+  if (!json.done()) throw std::logic_error("unbalanced JSON");
+  out << "\n";
+  if (!out) throw std::runtime_error("error writing " + options.json.string());
+}
+
+int run(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim) {
+  std::vector<Report> reports;
+  std::optional<StepEvaluator> last;
+  if (!options.segments.empty()) {
+    if (options.ground_truth.empty() == !sim.scene_selected()) {
+      spdlog::error("with --segments give the ground truth: --ground-truth FILE or --scene NAME");
+      return 1;
+    }
+    const auto sensor = sim.scene_selected() ? std::optional<SensorSize>(sim.scene().sensor) : pipeline_options.sensor();
+    if (!sensor) {
+      spdlog::error("give the sensor size (--width/--height or --config) for file-only evaluation");
+      return 1;
+    }
+    last.emplace(evaluate_files(options, *sensor, sim));
+    reports.push_back(make_report(*last));
+    reports.back().label = options.segments.filename().string();
+  } else {
+    if (!sim.scene_selected()) {
+      spdlog::error("give --segments FILE, or --scene NAME to run the pipeline on a built-in scene");
+      return 1;
+    }
+    const Scene scene = sim.scene();
+    const PipelineConfig base = pipeline_options.resolve(scene.sensor);
+    std::vector<float> thresholds = options.pr_thresholds;
+    if (thresholds.empty()) thresholds.push_back(base.score.fit_threshold);
+    for (const float threshold : thresholds) {
+      PipelineConfig config = base;
+      config.score.fit_threshold = threshold;
+      const auto started = std::chrono::steady_clock::now();
+      last.emplace(scene.sensor, options.tolerances);
+      const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last);
+      Report r = make_report(*last);
+      r.label = scene.name;
+      r.threshold = threshold;
+      r.events = result.events;
+      r.scene_seconds = result.scene_seconds;
+      r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, r.events, r.wall_seconds);
+      reports.push_back(r);
+    }
+  }
+  print_table(reports, options);
+  if (!options.json.empty()) write_json(reports, options);
+  if (!options.pr_png.empty()) {
+    std::vector<PrPoint> points;
+    for (const Report& r : reports) points.push_back({r.threshold, r.summed[0].precision, r.summed[0].recall, r.summed[0].f});
+    write_pr_curve_png(options.pr_png, points, reports.front().label + " PR over f_th (tolerance " +
+                                                   std::to_string(options.tolerances[0] * 100).substr(0, 3) + "% of diagonal)");
+  }
+  if (!options.lifetime_png.empty()) {
+    write_histogram_png(options.lifetime_png, last->lifetimes().histogram(options.histogram_bin_ms), options.histogram_bin_ms,
+                        reports.back().label + " segment lifetimes");
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"evldt-eval: line heat-map precision/recall/F (pixels matched one-to-one within a tolerance of the\n"
+               "image diagonal, counts summed over steps) and segment lifetimes. Either score a segment CSV\n"
+               "against --ground-truth CSV or a --scene, or run the pipeline on --scene (with --pr-thresholds, once per f_th)."};
+  Options options;
+  PipelineOptions pipeline_options;
+  SimulatorOptions sim_options;
+  app.add_option("--segments", options.segments, "Predicted segments CSV (from evldt-offline)")->check(CLI::ExistingFile);
+  app.add_option("--ground-truth", options.ground_truth, "Ground-truth CSV (from evldt-sim)")->check(CLI::ExistingFile);
+  sim_options.add_to(app, /*scene_required=*/false);
+  app.add_option("--tolerance", options.tolerances, "Match tolerances as fractions of the diagonal")
+      ->capture_default_str()
+      ->check(finite_number() & CLI::Range(0.0001, 0.5));
+  app.add_option("--step-us", options.step_us, "Scene runs: event time between scored steps")
+      ->capture_default_str()
+      ->check(CLI::Range(Timestamp{100}, Timestamp{10'000'000}));
+  app.add_option("--pr-thresholds", options.pr_thresholds, "Scene runs: f_th values for a PR curve")
+      ->check(finite_number() & CLI::Range(0.0, 1.0));
+  app.add_option("--json", options.json, "Write the results as JSON");
+  app.add_option("--pr-png", options.pr_png, "Plot precision/recall over the thresholds (first tolerance)");
+  app.add_option("--lifetime-png", options.lifetime_png, "Histogram of segment lifetimes");
+  app.add_option("--lifetime-bin-ms", options.histogram_bin_ms, "Histogram bin width")
+      ->capture_default_str()
+      ->check(finite_number() & CLI::Range(0.1, 1e6));
+  add_log_level_option(app, options.log_level);
+  pipeline_options.add_to(app);
+  CLI11_PARSE(app, argc, argv);
+  apply_log_level(options.log_level);
+  try {
+    return run(options, pipeline_options, sim_options);
+  } catch (const std::exception& error) {
+    spdlog::error("{}", error.what());
+    return 1;
+  }
+}
