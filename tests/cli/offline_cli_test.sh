@@ -69,11 +69,14 @@ awk -F, 'NR == 1 { print "t_us,id,x0,y0,x1,y1,score,status"; next } { print $1 "
   "$work/rec/ground_truth.csv" >"$work/gt_as_pred.csv"
 "$eval" --segments "$work/gt_as_pred.csv" --ground-truth "$work/rec/ground_truth.csv" --width 240 --height 180 \
   --json "$work/self.json" >"$work/self.txt"
-grep -Eq '^gt_as_pred.csv +0.000 +1.000 +1.000 +1.000 +1.000 +1.000 +1.000' "$work/self.txt" || fail "self-evaluation: $(cat "$work/self.txt")"
+grep -Eq '^gt_as_pred.csv +- +1.000 +1.000 +1.000 +1.000 +1.000 +1.000' "$work/self.txt" || fail "self-evaluation: $(cat "$work/self.txt")"
 "$offline" "$work/rec/events.raw" -o "$work/p.csv" -q >/dev/null
 "$eval" --segments "$work/p.csv" --scene boxes-6dof --duration-s 0.4 | tail -1 | awk '{ $1 = ""; $2 = ""; print }' >"$work/from_file.txt"
 "$eval" --scene boxes-6dof --duration-s 0.4 --log-level warn --lifetime-png "$work/life.png" | tail -1 | awk '{ $1 = ""; $2 = ""; print }' >"$work/in_process.txt"
-cmp -s "$work/from_file.txt" "$work/in_process.txt" || fail "file and in-process evaluation differ: $(cat "$work/from_file.txt") vs $(cat "$work/in_process.txt")"
+# The CSV keeps coordinates to 1/1000 px, so P/R/F may differ in the third decimal; counts and lifetimes may not.
+paste -d' ' "$work/from_file.txt" "$work/in_process.txt" | awk '{ n = NF / 2; for (i = 1; i <= n; ++i) {
+    d = $i - $(i + n); if (d < 0) d = -d; if ((i <= 6 && d > 0.002) || (i > 6 && d != 0)) exit 1 } }' ||
+  fail "file and in-process evaluation differ: $(cat "$work/from_file.txt") vs $(cat "$work/in_process.txt")"
 [[ -s "$work/life.png" ]] || fail "no lifetime histogram"
 echo "ok: evaluation of ground truth against itself is perfect; file and in-process scores agree: $(cat "$work/in_process.txt")"
 echo "offline CLI: 8 passed, 0 failed"

@@ -32,7 +32,7 @@ struct Options {
 
 struct Report {
   std::string label;
-  float threshold = 0;
+  std::optional<float> threshold;  ///< set for pipeline runs; a segment file's is unknown
   std::vector<Prf> summed;
   double mean_predicted = 0, mean_ground_truth = 0;
   std::uint64_t steps = 0;
@@ -89,7 +89,11 @@ void print_table(const std::vector<Report>& reports, const Options& options) {
   for (const double tol : options.tolerances) std::printf("   P@%.0f%%   R@%.0f%%   F@%.0f%%", tol * 100, tol * 100, tol * 100);
   std::printf("  segs/step  gt/step  ids  life_mean_ms life_max_ms\n");
   for (const Report& r : reports) {
-    std::printf("%-24s %6.3f", r.label.c_str(), static_cast<double>(r.threshold));
+    if (r.threshold) {
+      std::printf("%-24s %6.3f", r.label.c_str(), static_cast<double>(*r.threshold));
+    } else {
+      std::printf("%-24s %6s", r.label.c_str(), "-");
+    }
     for (const Prf& p : r.summed) std::printf("  %6.3f  %6.3f  %6.3f", p.precision, p.recall, p.f);
     std::printf("  %9.1f  %7.1f  %4llu  %11.1f %11.1f\n", r.mean_predicted, r.mean_ground_truth,
                 static_cast<unsigned long long>(r.lifetime.count), r.lifetime.mean_ms, r.lifetime.max_ms);
@@ -102,7 +106,12 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
   JsonWriter json(out);
   json.begin_object().key("runs").begin_array();
   for (const Report& r : reports) {
-    json.begin_object().key("run").value(r.label).key("fit_threshold").value(static_cast<double>(r.threshold));
+    json.begin_object().key("run").value(r.label).key("fit_threshold");
+    if (r.threshold) {
+      json.value(static_cast<double>(*r.threshold));
+    } else {
+      json.null();
+    }
     json.key("steps").value(r.steps).key("events").value(r.events).key("scene_seconds").value(r.scene_seconds);
     json.key("wall_seconds").value(r.wall_seconds);
     json.key("accuracy").begin_array();
@@ -167,7 +176,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   if (!options.json.empty()) write_json(reports, options);
   if (!options.pr_png.empty()) {
     std::vector<PrPoint> points;
-    for (const Report& r : reports) points.push_back({r.threshold, r.summed[0].precision, r.summed[0].recall, r.summed[0].f});
+    for (const Report& r : reports) points.push_back({r.threshold.value_or(0.0f), r.summed[0].precision, r.summed[0].recall, r.summed[0].f});
     write_pr_curve_png(options.pr_png, points, reports.front().label + " PR over f_th (tolerance " +
                                                    std::to_string(options.tolerances[0] * 100).substr(0, 3) + "% of diagonal)");
   }

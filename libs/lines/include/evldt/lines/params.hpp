@@ -27,7 +27,7 @@ struct ScoreParams {
 
 struct TrackParams {
   float perturbation_px = 2.5f;  ///< dq
-  int max_bad_tracks = 3;        ///< consecutive BadTrack rounds before a line is released
+  int max_bad_tracks = 10;       ///< consecutive BadTrack rounds before a line is released (chosen by the accuracy benchmark)
   EffectiveRatioNorm multi_block_norm = EffectiveRatioNorm::Block;
 };
 
