@@ -2,22 +2,11 @@
 
 #include <algorithm>
 #include <cinttypes>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
 namespace evldt {
-
-SegmentCsvWriter::SegmentCsvWriter(const std::filesystem::path& path) : path_(path) {
-  file_ = std::fopen(path.c_str(), "w");
-  if (file_ == nullptr) throw std::runtime_error("cannot create " + path.string());
-  std::fprintf(file_, "%s\n", kSegmentCsvHeader);
-}
-
-SegmentCsvWriter::~SegmentCsvWriter() {
-  if (file_ != nullptr) std::fclose(file_);
-}
 
 void SegmentCsvWriter::write_step(Timestamp t, std::span<const TrackedLine> lines) {
   sorted_.clear();
@@ -25,19 +14,11 @@ void SegmentCsvWriter::write_step(Timestamp t, std::span<const TrackedLine> line
   std::sort(sorted_.begin(), sorted_.end(), [](const TrackedLine* a, const TrackedLine* b) { return a->id < b->id; });
   for (const TrackedLine* line : sorted_) {
     const Segment& s = line->segment;
-    std::fprintf(file_, "%" PRId64 ",%" PRIu64 ",%.3f,%.3f,%.3f,%.3f,%.4f,%s\n", t, line->id, static_cast<double>(s.q0.x()),
+    std::fprintf(output_.file(), "%" PRId64 ",%" PRIu64 ",%.3f,%.3f,%.3f,%.3f,%.4f,%s\n", t, line->id, static_cast<double>(s.q0.x()),
                  static_cast<double>(s.q0.y()), static_cast<double>(s.q1.x()), static_cast<double>(s.q1.y()),
                  static_cast<double>(line->score), status_name(line->status).data());
   }
   rows_ += sorted_.size();
-}
-
-void SegmentCsvWriter::close() {
-  if (file_ == nullptr) return;
-  const bool failed = std::ferror(file_) != 0;
-  const bool close_failed = std::fclose(file_) != 0;
-  file_ = nullptr;
-  if (failed || close_failed) throw std::runtime_error("error writing " + path_.string());
 }
 
 namespace {
@@ -52,19 +33,8 @@ LineStatus parse_status(const std::string& text) {
 }  // namespace
 
 std::vector<SegmentRow> read_segment_csv(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot open " + path.string());
   std::vector<SegmentRow> rows;
-  std::string line;
-  std::size_t number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (number == 1) {
-      if (line != kSegmentCsvHeader) throw std::runtime_error(path.string() + ":1: not a segment CSV (header '" + line + "')");
-      continue;
-    }
-    if (line.empty()) continue;
+  read_csv_rows(path, kSegmentCsvHeader, [&](const std::string& line) {
     std::istringstream fields(line);
     SegmentRow row;
     char c[7];
@@ -73,16 +43,12 @@ std::vector<SegmentRow> read_segment_csv(const std::filesystem::path& path) {
     if (!(fields >> row.t_us >> c[0] >> row.id >> c[1] >> x0 >> c[2] >> y0 >> c[3] >> x1 >> c[4] >> y1 >> c[5] >> row.score >>
           c[6]) ||
         std::count(c, c + 7, ',') != 7 || !std::getline(fields, status)) {
-      throw std::runtime_error(path.string() + ":" + std::to_string(number) + ": malformed row '" + line + "'");
+      throw std::invalid_argument("malformed row '" + line + "'");
     }
-    try {
-      row.status = parse_status(status);
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(path.string() + ":" + std::to_string(number) + ": " + e.what());
-    }
+    row.status = parse_status(status);
     row.segment = {Point2(x0, y0), Point2(x1, y1)};
     rows.push_back(row);
-  }
+  });
   return rows;
 }
 

@@ -2,11 +2,11 @@
 // Segments over time as CSV: "t_us,id,x0,y0,x1,y1,score,status", one row per live segment per
 // output step, rows of a step sorted by id. Coordinates are continuous image coordinates.
 
-#include <cstdio>
 #include <filesystem>
 #include <span>
 #include <vector>
 
+#include "evldt/events/csv_file.hpp"
 #include "evldt/lines/line_map.hpp"
 
 namespace evldt {
@@ -16,19 +16,15 @@ inline constexpr const char* kSegmentCsvHeader = "t_us,id,x0,y0,x1,y1,score,stat
 class SegmentCsvWriter {
  public:
   /// Throws std::runtime_error naming the path if it cannot be created.
-  explicit SegmentCsvWriter(const std::filesystem::path& path);
-  ~SegmentCsvWriter();
-  SegmentCsvWriter(const SegmentCsvWriter&) = delete;
-  SegmentCsvWriter& operator=(const SegmentCsvWriter&) = delete;
+  explicit SegmentCsvWriter(const std::filesystem::path& path) : output_(path, kSegmentCsvHeader) {}
 
   void write_step(Timestamp t, std::span<const TrackedLine> lines);
   /// Flushes and checks for write errors (throws std::runtime_error).
-  void close();
+  void close() { output_.close(); }
   [[nodiscard]] std::uint64_t rows() const { return rows_; }
 
  private:
-  std::filesystem::path path_;
-  std::FILE* file_ = nullptr;
+  CsvOutput output_;
   std::vector<const TrackedLine*> sorted_;
   std::uint64_t rows_ = 0;
 };

@@ -2,11 +2,11 @@
 // Ground-truth segments over time as CSV: "t_us,gt_id,x0,y0,x1,y1", one row per visible edge piece
 // per step (continuous image coordinates; see scarf_lattice.hpp).
 
-#include <cstdio>
 #include <filesystem>
 #include <span>
 #include <vector>
 
+#include "evldt/events/csv_file.hpp"
 #include "evldt/sim/scene.hpp"
 
 namespace evldt {
@@ -15,16 +15,12 @@ inline constexpr const char* kGroundTruthCsvHeader = "t_us,gt_id,x0,y0,x1,y1";
 
 class GroundTruthCsvWriter {
  public:
-  explicit GroundTruthCsvWriter(const std::filesystem::path& path);
-  ~GroundTruthCsvWriter();
-  GroundTruthCsvWriter(const GroundTruthCsvWriter&) = delete;
-  GroundTruthCsvWriter& operator=(const GroundTruthCsvWriter&) = delete;
+  explicit GroundTruthCsvWriter(const std::filesystem::path& path) : output_(path, kGroundTruthCsvHeader) {}
   void write_step(Timestamp t, std::span<const GtSegment> segments);
-  void close();  ///< throws std::runtime_error on a write error
+  void close() { output_.close(); }  ///< throws std::runtime_error on a write error
 
  private:
-  std::filesystem::path path_;
-  std::FILE* file_ = nullptr;
+  CsvOutput output_;
 };
 
 struct GroundTruthRow {

@@ -1,0 +1,48 @@
+#include "evldt/events/csv_file.hpp"
+
+#include <fstream>
+#include <stdexcept>
+
+namespace evldt {
+
+CsvOutput::CsvOutput(const std::filesystem::path& path, std::string_view header) : path_(path) {
+  file_ = std::fopen(path.c_str(), "w");
+  if (file_ == nullptr) throw std::runtime_error("cannot create " + path.string());
+  std::fprintf(file_, "%.*s\n", static_cast<int>(header.size()), header.data());
+}
+
+CsvOutput::~CsvOutput() {
+  if (file_ != nullptr) std::fclose(file_);
+}
+
+void CsvOutput::close() {
+  if (file_ == nullptr) return;
+  const bool failed = std::ferror(file_) != 0;
+  const bool close_failed = std::fclose(file_) != 0;
+  file_ = nullptr;
+  if (failed || close_failed) throw std::runtime_error("error writing " + path_.string());
+}
+
+void read_csv_rows(const std::filesystem::path& path, std::string_view header,
+                   const std::function<void(const std::string& row)>& parse_row) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot open " + path.string());
+  std::string line;
+  std::size_t number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (number == 1) {
+      if (line != header) throw std::runtime_error(path.string() + ":1: expected the header '" + std::string(header) + "'");
+      continue;
+    }
+    if (line.empty()) continue;
+    try {
+      parse_row(line);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(path.string() + ":" + std::to_string(number) + ": " + e.what());
+    }
+  }
+}
+
+}  // namespace evldt
