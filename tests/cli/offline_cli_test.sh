@@ -15,7 +15,11 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 for bin in "$sim" "$offline" "$eval"; do
   "$bin" --help >"$work/help" || fail "$bin --help exit status"
   grep -q "Usage" "$work/help" || fail "$bin --help text"
-  if "$bin" --no-such-flag >"$work/out" 2>&1; then fail "$bin accepted an unknown flag"; fi
+  set +e
+  "$bin" --no-such-flag >"$work/out" 2>&1
+  status=$?
+  set -e
+  [[ $status -eq 1 ]] || fail "$bin --no-such-flag: exit status $status, not 1"
   grep -q "no-such-flag" "$work/out" || fail "$bin: unknown flag not named in the error"
 done
 echo "ok: --help and unknown flags"

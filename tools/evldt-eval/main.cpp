@@ -27,7 +27,6 @@ struct Options {
   std::vector<float> pr_thresholds;
   Timestamp step_us = 10000;
   double histogram_bin_ms = 50;
-  std::string log_level = "info";
 };
 
 struct Report {
@@ -213,14 +212,6 @@ int main(int argc, char** argv) {
   app.add_option("--lifetime-bin-ms", options.histogram_bin_ms, "Histogram bin width")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.1, 1e6));
-  add_log_level_option(app, options.log_level);
   pipeline_options.add_to(app);
-  CLI11_PARSE(app, argc, argv);
-  apply_log_level(options.log_level);
-  try {
-    return run(options, pipeline_options, sim_options);
-  } catch (const std::exception& error) {
-    spdlog::error("{}", error.what());
-    return 1;
-  }
+  return run_main(app, argc, argv, [&] { return run(options, pipeline_options, sim_options); });
 }

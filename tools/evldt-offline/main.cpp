@@ -38,7 +38,6 @@ struct Options {
   int render_scale = 2;
   bool show_ids = false;
   bool quiet = false;
-  std::string log_level = "info";
 };
 
 // Renders output steps to an mp4 and/or PNG files, at most once per render period of event time.
@@ -210,14 +209,6 @@ int main(int argc, char** argv) {
   app.add_option("--render-scale", options.render_scale, "Zoom of rendered frames")->capture_default_str()->check(CLI::Range(1, 8));
   app.add_flag("--show-ids", options.show_ids, "Write line ids on rendered frames");
   app.add_flag("-q,--quiet", options.quiet, "No progress lines");
-  add_log_level_option(app, options.log_level);
   pipeline_options.add_to(app);
-  CLI11_PARSE(app, argc, argv);
-  apply_log_level(options.log_level);
-  try {
-    return run(options, pipeline_options, sim_options);
-  } catch (const std::exception& error) {
-    spdlog::error("{}", error.what());
-    return 1;
-  }
+  return run_main(app, argc, argv, [&] { return run(options, pipeline_options, sim_options); });
 }

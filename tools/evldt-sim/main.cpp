@@ -85,7 +85,6 @@ int main(int argc, char** argv) {
   Timestamp gt_period_us = 10000;
   bool quiet = false;
   bool list = false;
-  std::string log_level = "info";
   sim_options.add_to(app, /*scene_required=*/true);
   app.add_option("-o,--out-dir", out_dir, "Directory to write into")->capture_default_str();
   app.add_option("--format", formats, "Recording formats to write: evt3 (events.raw), ecd (events.txt), evt2, dat")
@@ -96,21 +95,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(Timestamp{100}, Timestamp{10'000'000}));
   app.add_flag("--list", list, "List the built-in scenes and exit");
   app.add_flag("-q,--quiet", quiet, "No progress lines");
-  add_log_level_option(app, log_level);
-  CLI11_PARSE(app, argc, argv);
-  apply_log_level(log_level);
-  if (list) {
+  return run_main(app, argc, argv, [&] {
+    if (!list) return run(sim_options, out_dir, formats, gt_period_us, quiet);
     for (const auto& name : scene_names()) {
       const Scene s = make_scene(name);
       std::printf("%-18s %dx%d  %.2f s  %zu shapes%s\n", name.c_str(), s.sensor.width, s.sensor.height,
                   static_cast<double>(s.duration_us) * 1e-6, s.shapes.size(), name == kDefaultScene ? "  (default)" : "");
     }
     return 0;
-  }
-  try {
-    return run(sim_options, out_dir, formats, gt_period_us, quiet);
-  } catch (const std::exception& error) {
-    spdlog::error("{}", error.what());
-    return 1;
-  }
+  });
 }

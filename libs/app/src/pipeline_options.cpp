@@ -73,16 +73,25 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   return config;
 }
 
-void add_log_level_option(CLI::App& app, std::string& level) {
+int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+  std::string level = "info";
   app.add_option("--log-level", level, "Log level: trace, debug, info, warn, error, off")
       ->capture_default_str()
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
-}
-
-void apply_log_level(const std::string& level) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    return app.exit(error) == 0 ? 0 : 1;  // --help is 0; every usage error is 1
+  }
   // Logs and progress go to stderr, so stdout carries only a tool's results and summary.
   if (!spdlog::get("evldt")) spdlog::set_default_logger(spdlog::stderr_color_mt("evldt"));
   spdlog::set_level(spdlog::level::from_str(level));
+  try {
+    return body();
+  } catch (const std::exception& error) {
+    spdlog::error("{}", error.what());
+    return 1;
+  }
 }
 
 }  // namespace evldt

@@ -3,6 +3,7 @@
 // means the same everywhere. Values left unset fall back to the defaults for the sensor size.
 
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -34,8 +35,9 @@ class PipelineOptions {
 /// CLI11's Range accepts NaN (every comparison with it is false): floating options also need this.
 const CLI::Validator& finite_number();
 
-/// --log-level (trace, debug, info, warn, error, off); apply_log_level also sends logs to stderr.
-void add_log_level_option(CLI::App& app, std::string& level);
-void apply_log_level(const std::string& level);
+/// The end of every tool's main: adds --log-level, parses the command line (a usage error is exit
+/// status 1, --help 0), sends logs to stderr at that level, and runs `body`, turning an
+/// escaping exception into a logged error and exit status 1.
+int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
 
 }  // namespace evldt
