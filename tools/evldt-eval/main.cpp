@@ -2,7 +2,7 @@
 // ground truth, from files or by running the pipeline on a built-in scene (also over thresholds).
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
+#include <iterator>
 #include <chrono>
 #include <cstdio>
 #include <fstream>

@@ -2,7 +2,6 @@
 // Scoring a stream of predicted segments against ground truth, step by step: the heat-map counts at
 // each tolerance, and the lifetime of every predicted id.
 
-#include <functional>
 #include <span>
 #include <vector>
 
