@@ -22,6 +22,7 @@ TEST(SegmentCsv, RoundTripSortedByIdAndMalformedRowsNamed) {
   writer.write_step(1000, lines);
   writer.close();
   EXPECT_EQ(writer.rows(), 2u);
+  EXPECT_THROW(writer.write_step(2000, lines), std::logic_error);
   const auto rows = read_segment_csv(dir / "s.csv");
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[0].id, 4u);  // sorted by id within the step

@@ -15,6 +15,11 @@ CsvOutput::~CsvOutput() {
   if (file_ != nullptr) std::fclose(file_);
 }
 
+std::FILE* CsvOutput::file() const {
+  if (file_ == nullptr) throw std::logic_error("write to " + path_.string() + " after it was closed");
+  return file_;
+}
+
 void CsvOutput::close() {
   if (file_ == nullptr) return;
   const bool failed = std::ferror(file_) != 0;

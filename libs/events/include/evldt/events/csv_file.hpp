@@ -17,7 +17,8 @@ class CsvOutput {
   ~CsvOutput();
   CsvOutput(const CsvOutput&) = delete;
   CsvOutput& operator=(const CsvOutput&) = delete;
-  [[nodiscard]] std::FILE* file() const { return file_; }
+  /// The open file; throws std::logic_error after close() instead of handing out a null stream.
+  [[nodiscard]] std::FILE* file() const;
   /// Flushes and checks for write errors (throws std::runtime_error); idempotent.
   void close();
 
