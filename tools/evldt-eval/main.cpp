@@ -16,6 +16,7 @@
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/lines/segment_csv.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
+#include "evldt/transport/lcm_log.hpp"
 
 namespace {
 
@@ -23,6 +24,7 @@ using namespace evldt;
 
 struct Options {
   std::filesystem::path segments, ground_truth, json, pr_png, lifetime_png;
+  std::string lcm_channel;
   std::vector<double> tolerances{0.01, 0.02};
   std::vector<float> pr_thresholds;
   Timestamp step_us = 10000;
@@ -53,7 +55,8 @@ Report make_report(const StepEvaluator& evaluator) {
 
 // Predictions and ground truth read from CSV files; ground truth of a step is the latest GT row time <= t.
 StepEvaluator evaluate_files(const Options& options, SensorSize sensor, const SimulatorOptions& sim) {
-  const auto rows = read_segment_csv(options.segments);
+  const auto rows = is_lcm_log(options.segments) ? read_segment_log(options.segments, options.lcm_channel)
+                                                 : read_segment_csv(options.segments);
   std::map<Timestamp, std::vector<Segment>> gt_by_time;
   if (!options.ground_truth.empty()) {
     for (const auto& g : read_ground_truth_csv(options.ground_truth)) {
@@ -195,7 +198,9 @@ int main(int argc, char** argv) {
   Options options;
   PipelineOptions pipeline_options;
   SimulatorOptions sim_options;
-  app.add_option("--segments", options.segments, "Predicted segments CSV (from evldt-offline)")->check(CLI::ExistingFile);
+  app.add_option("--segments", options.segments, "Predicted segments: CSV (from evldt-offline) or an lcm-log with segment lists")
+      ->check(CLI::ExistingFile);
+  app.add_option("--lcm-channel", options.lcm_channel, "Segment channel of an lcm-log (default: the first LINES_*)");
   app.add_option("--ground-truth", options.ground_truth, "Ground-truth CSV (from evldt-sim)")->check(CLI::ExistingFile);
   sim_options.add_to(app, /*scene_required=*/false);
   app.add_option("--tolerance", options.tolerances, "Match tolerances as fractions of the diagonal")

@@ -94,6 +94,10 @@ EngineCounters RealtimeEngine::counters() const {
     c.events = events_stored_;
     c.latest_event_us = latest_event_us_;
   }
+  {
+    std::lock_guard lock(lines_mutex_);
+    c.lines_created = lines_.created();
+  }
   c.detect_rounds = detect_rounds_.load(std::memory_order_relaxed);
   c.track_rounds = track_rounds_.load(std::memory_order_relaxed);
   return c;

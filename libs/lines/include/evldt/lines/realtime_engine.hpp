@@ -19,6 +19,7 @@ struct EngineCounters {
   std::uint64_t events = 0;
   std::uint64_t detect_rounds = 0;
   std::uint64_t track_rounds = 0;
+  std::uint64_t lines_created = 0;
   Timestamp latest_event_us = 0;
 };
 

@@ -1,0 +1,45 @@
+#include "evldt/app/source_options.hpp"
+
+#include <stdexcept>
+
+#include "evldt/app/pipeline_options.hpp"
+
+namespace evldt {
+
+void SourceOptions::add_to(CLI::App& app) {
+  app.add_option("input", recording_,
+                 "Recording: ECD events.txt, Prophesee RAW (EVT 2.0/3.0), .dat, or an lcm-log of event batches")
+      ->check(CLI::ExistingFile);
+  app.add_option("--format", format_, "Recording format when the name does not tell: ecd, evt2, evt3, dat")
+      ->check(CLI::IsMember({"ecd", "evt2", "evt3", "dat"}));
+  app.add_option("--lcm-channel", lcm_channel_, "Event channel of an lcm-log input (default: the first EVENTS_*)");
+  app.add_option("--from-video", video_,
+                 "Video file or webcam index: events by frame differencing (thresholds: --contrast, --contrast-sigma, "
+                 "--refractory-us, --seed)");
+  app.add_option("--video-fps", video_fps_, "Frame rate of --from-video where the file does not say (default 30)")
+      ->check(finite_number() & CLI::Range(0.1, 10000.0));
+  simulator_.add_to(app, /*scene_required=*/false);
+}
+
+std::unique_ptr<EventSource> SourceOptions::open(Timestamp backwards_slack_us) const {
+  const int selected = int{!recording_.empty()} + int{simulator_.scene_selected()} + int{!video_.empty()};
+  if (selected != 1) {
+    throw std::invalid_argument("give exactly one source: a recording file, --scene NAME or --from-video FILE|INDEX");
+  }
+  if (simulator_.scene_selected()) return open_scene(simulator_.scene(), simulator_.config(), simulator_.scene_name());
+  if (!video_.empty()) {
+    const SimulatorConfig model = simulator_.config();
+    VideoSourceOptions video{video_, {}, video_fps_};
+    video.emulator.contrast_on = model.contrast_on;
+    video.emulator.contrast_off = model.contrast_off;
+    video.emulator.contrast_sigma = model.contrast_sigma;
+    video.emulator.refractory_us = model.refractory_us;
+    video.emulator.seed = model.seed;
+    return open_video(video);
+  }
+  std::optional<EventFormat> format;
+  if (!format_.empty()) format = parse_event_format(format_);
+  return open_recording(recording_, format, lcm_channel_, backwards_slack_us);
+}
+
+}  // namespace evldt

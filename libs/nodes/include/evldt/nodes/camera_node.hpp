@@ -1,0 +1,68 @@
+#pragma once
+// The evldt-camera service without its command line: reads an event source, validates its events,
+// cuts them into batches by time window and size, and publishes them paced at real time (or a
+// speed factor), optionally looping the source with time continuing forward.
+
+#include <atomic>
+#include <functional>
+#include <lcm/lcm-cpp.hpp>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "evldt/events/event_validator.hpp"
+#include "evldt/event_batch_t.hpp"
+#include "evldt/sources/event_source.hpp"
+
+namespace evldt {
+
+struct CameraNodeOptions {
+  std::string camera = "cam0";
+  std::optional<SensorSize> sensor;  ///< unset: the source's own
+  Timestamp batch_us = 1000;
+  std::size_t max_batch = 7000;      ///< about one 64 KiB datagram
+  double speed = 1.0;                ///< 0: as fast as possible
+  bool loop = false;
+  Timestamp time_slack_us = 1000;
+  double progress_period_s = 2;      ///< a progress line this often (0: none)
+};
+
+struct CameraSummary {
+  std::string source;
+  SensorSize sensor;
+  std::uint64_t events_read = 0;
+  std::uint64_t events_published = 0;
+  DropCounts drops;
+  std::uint64_t batches = 0;
+  std::uint64_t publish_failures = 0;
+  std::uint64_t bytes = 0;           ///< encoded message bytes published
+  std::uint64_t loops = 0;           ///< times the source was restarted by --loop
+  double event_seconds = 0;          ///< event time published
+  double wall_seconds = 0;
+  double max_lag_s = 0;              ///< furthest behind the pace
+  std::string input_error;           ///< set if the source ended in a format error
+
+  void print(std::FILE* out) const;
+};
+
+class CameraNode {
+ public:
+  using SourceFactory = std::function<std::unique_ptr<EventSource>()>;
+  /// `epoch_us` (the process start) goes in every batch so subscribers see a restart.
+  CameraNode(lcm::LCM& lcm, CameraNodeOptions options, std::int64_t epoch_us);
+
+  /// Publishes the source (reopened by `open_source` for every loop) until it ends or `stop` is
+  /// set. Throws std::runtime_error if the sensor size is unknown.
+  CameraSummary run(const SourceFactory& open_source, const std::atomic<bool>& stop);
+
+ private:
+  void publish(const EventBatch& batch, CameraSummary& summary);
+
+  lcm::LCM& lcm_;
+  CameraNodeOptions options_;
+  std::int64_t epoch_us_;
+  std::string channel_;
+  event_batch_t msg_;
+};
+
+}  // namespace evldt

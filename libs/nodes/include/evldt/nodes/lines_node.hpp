@@ -1,0 +1,89 @@
+#pragma once
+// The evldt-lines service without its command line: subscribes to one camera's event batches,
+// stores them in the real-time engine on the receive thread (which never waits for a detection or
+// tracking pass), and publishes the live segments at a set rate and its statistics once a second.
+
+#include <atomic>
+#include <functional>
+#include <lcm/lcm-cpp.hpp>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "evldt/lines/realtime_engine.hpp"
+#include "evldt/transport/event_batch_receiver.hpp"
+#include "evldt/transport/latency_tracker.hpp"
+
+namespace evldt {
+
+struct LinesNodeOptions {
+  std::string camera = "cam0";
+  std::optional<SensorSize> sensor;  ///< unset: adopt the first valid batch's
+  std::function<PipelineConfig(SensorSize)> configure = default_config_for;
+  Timestamp time_slack_us = 1000;
+  double publish_hz = 100;
+  double stats_hz = 1;
+  double log_period_s = 10;  ///< a status line in the log this often (0: never)
+};
+
+/// Totals since start (what the stats message and the exit summary report).
+struct LinesNodeTotals {
+  ReceiverCounts receiver;
+  std::uint64_t events_stored = 0;
+  std::uint64_t detect_rounds = 0;
+  std::uint64_t track_rounds = 0;
+  std::uint64_t lines_created = 0;
+  std::uint64_t lists_published = 0;
+  std::uint64_t engine_restarts = 0;  ///< the camera restarted (new epoch): the lattice began afresh
+};
+
+class LinesNode {
+ public:
+  /// Subscribes at once. `epoch_us` (the process start) is sent in every message and is the first
+  /// line id, so a restarted process never repeats an id.
+  LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch_us);
+  ~LinesNode();
+  LinesNode(const LinesNode&) = delete;
+  LinesNode& operator=(const LinesNode&) = delete;
+
+  /// Receives and publishes until `stop` is set (checked every 100 ms), then stops the engine.
+  void run(const std::atomic<bool>& stop);
+  [[nodiscard]] LinesNodeTotals totals() const;
+
+ private:
+  void on_events(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void start_engine();
+  void publish_loop(const std::atomic<bool>& stop);
+  void publish_segments();
+  void publish_stats(double period_s);
+  [[nodiscard]] std::shared_ptr<RealtimeEngine> engine() const;
+
+  lcm::LCM& lcm_;
+  LinesNodeOptions options_;
+  std::int64_t epoch_us_;
+  std::string lines_channel_;
+  lcm::Subscription* subscription_ = nullptr;
+
+  // Receive thread only.
+  EventBatchReceiver receiver_;
+  EventBatch batch_;
+
+  mutable std::mutex mutex_;  // guards the members below (the receive thread alone writes them)
+  std::uint64_t next_line_id_;
+  std::shared_ptr<RealtimeEngine> engine_;
+  ReceiverCounts receiver_counts_;
+  LatencyTracker latency_;
+  std::uint64_t engine_restarts_ = 0;
+  EngineCounters retired_;  ///< summed over the engines of earlier camera epochs
+
+  // Publish thread only.
+  std::vector<TrackedLine> lines_;
+  segment_list_t list_msg_;
+  std::int64_t list_seq_ = 0;
+  std::atomic<std::uint64_t> lists_published_{0};
+  LinesNodeTotals last_stats_;
+};
+
+}  // namespace evldt

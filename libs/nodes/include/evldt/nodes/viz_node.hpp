@@ -1,0 +1,71 @@
+#pragma once
+// The evldt-viz service without its command line: subscribes to one camera's events, segments and
+// the lines service's statistics, keeps a SCARF lattice of the events for the surface image, and
+// renders frames at a set rate (surface, segments coloured by status, a status line).
+
+#include <atomic>
+#include <functional>
+#include <lcm/lcm-cpp.hpp>
+#include <optional>
+#include <string>
+
+#include "evldt/lines/params.hpp"
+#include "evldt/render/scene_renderer.hpp"
+#include "evldt/scarf/scarf_lattice.hpp"
+#include "evldt/transport/event_batch_receiver.hpp"
+
+namespace evldt {
+
+struct VizNodeOptions {
+  std::string camera = "cam0";
+  std::optional<SensorSize> sensor;  ///< unset: the first valid batch's
+  double render_hz = 30;
+  RenderOptions render{2, false};
+  Timestamp time_slack_us = 1000;
+};
+
+struct VizTotals {
+  ReceiverCounts events;
+  std::uint64_t segment_lists = 0;
+  std::uint64_t invalid_segment_lists = 0;
+  std::uint64_t stats = 0;
+  std::uint64_t frames = 0;
+};
+
+class VizNode {
+ public:
+  /// Takes a rendered frame; returns false to stop.
+  using FrameHandler = std::function<bool(const cv::Mat& frame)>;
+  VizNode(lcm::LCM& lcm, VizNodeOptions options);
+  ~VizNode();
+  VizNode(const VizNode&) = delete;
+  VizNode& operator=(const VizNode&) = delete;
+
+  /// Receives until `stop` is set (or the handler says stop), handing a frame to `on_frame` render_hz times a second once the
+  /// first event batch has arrived. Everything runs on the calling thread (window toolkits need it).
+  void run(const std::atomic<bool>& stop, const FrameHandler& on_frame);
+  [[nodiscard]] const VizTotals& totals() const { return totals_; }
+
+ private:
+  void on_events(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void on_lines(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void on_stats(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void render(cv::Mat& canvas);
+
+  lcm::LCM& lcm_;
+  VizNodeOptions options_;
+  std::vector<lcm::Subscription*> subscriptions_;
+  EventBatchReceiver receiver_;
+  EventBatch batch_;
+  std::optional<ScarfLattice> lattice_;
+  std::uint64_t events_since_frame_ = 0;
+  double event_rate_ = 0;
+  segment_list_t lines_msg_;
+  std::vector<TrackedLine> lines_;
+  Timestamp lines_t_us_ = 0;
+  stats_t stats_msg_;
+  std::optional<stats_t> stats_;
+  VizTotals totals_;
+};
+
+}  // namespace evldt

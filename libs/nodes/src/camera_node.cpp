@@ -1,0 +1,138 @@
+#include "evldt/nodes/camera_node.hpp"
+
+#include <bit>
+#include <chrono>
+#include <spdlog/spdlog.h>
+#include <stdexcept>
+
+#include "evldt/transport/channels.hpp"
+#include "evldt/transport/event_batcher.hpp"
+#include "evldt/transport/messages.hpp"
+#include "evldt/transport/pacer.hpp"
+
+namespace evldt {
+namespace {
+using Clock = std::chrono::steady_clock;
+}  // namespace
+
+void CameraSummary::print(std::FILE* out) const {
+  const double rate = wall_seconds > 0 ? static_cast<double>(events_published) / wall_seconds : 0.0;
+  std::fprintf(out,
+               "evldt-camera summary\n"
+               "  source            %s (%dx%d)%s\n"
+               "  events            %llu read, %llu published, %llu dropped (%llu off sensor, %llu back in time)\n"
+               "  batches           %llu (%.1f events each), %.2f MB, %.2f bytes/event, %llu publish failures\n"
+               "  time              %.3f s of events in %.3f s wall (%.2fx), %.2f Mev/s, %llu loop restarts\n"
+               "  pace              furthest behind: %.1f ms\n",
+               source.c_str(), sensor.width, sensor.height, input_error.empty() ? "" : (" -- " + input_error).c_str(),
+               static_cast<unsigned long long>(events_read), static_cast<unsigned long long>(events_published),
+               static_cast<unsigned long long>(drops.total()), static_cast<unsigned long long>(drops.off_sensor),
+               static_cast<unsigned long long>(drops.time_backwards), static_cast<unsigned long long>(batches),
+               batches ? static_cast<double>(events_published) / static_cast<double>(batches) : 0.0,
+               static_cast<double>(bytes) * 1e-6,
+               events_published ? static_cast<double>(bytes) / static_cast<double>(events_published) : 0.0,
+               static_cast<unsigned long long>(publish_failures), event_seconds, wall_seconds,
+               wall_seconds > 0 ? event_seconds / wall_seconds : 0.0, rate * 1e-6,
+               static_cast<unsigned long long>(loops), max_lag_s * 1e3);
+}
+
+CameraNode::CameraNode(lcm::LCM& lcm, CameraNodeOptions options, std::int64_t epoch_us)
+    : lcm_(lcm), options_(std::move(options)), epoch_us_(epoch_us), channel_(events_channel(options_.camera)) {
+  if (options_.batch_us < 1 || options_.max_batch < 1 || !(options_.speed >= 0)) {
+    throw std::invalid_argument("batch window, batch size and speed must be positive");
+  }
+  if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
+}
+
+CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomic<bool>& stop) {
+  std::unique_ptr<EventSource> source = open_source();
+  CameraSummary summary;
+  summary.source = source->name();
+  const std::optional<SensorSize> sensor = options_.sensor ? options_.sensor : source->geometry();
+  if (!sensor) {
+    throw std::runtime_error(source->name() + " has no sensor size in its header: pass --width and --height");
+  }
+  if (!sensor->valid() || sensor->width > INT16_MAX || sensor->height > INT16_MAX) {
+    throw std::runtime_error("sensor size must be between 1x1 and 32767x32767");
+  }
+  summary.sensor = *sensor;
+  EventValidator validator(*sensor, options_.time_slack_us);
+  EventBatcher batcher(options_.batch_us, options_.max_batch);
+  Pacer pacer(options_.speed);
+  EventBatch chunk, batch;
+  std::optional<Timestamp> first_t;
+  Timestamp offset = 0;         // added to event times so every loop continues forward in time
+  bool rebase = false;
+  const auto started = Clock::now();
+  auto last_progress = started;
+  spdlog::info("publishing {} ({}x{}) on {} at {}", source->name(), sensor->width, sensor->height, channel_,
+               options_.speed > 0 ? fmt::format("{}x real time", options_.speed) : std::string("full speed"));
+
+  const auto publish_ready = [&](bool flush) {
+    while (!stop.load() && batcher.pop(batch, flush)) {
+      summary.max_lag_s = std::max(summary.max_lag_s, pacer.wait_until(batch.t.back(), stop));
+      publish(batch, summary);
+    }
+  };
+  try {
+    while (!stop.load()) {
+      if (!source->read(chunk)) {
+        if (!options_.loop) break;
+        source = open_source();
+        ++summary.loops;
+        rebase = true;
+        continue;
+      }
+      summary.events_read += chunk.size();
+      if (chunk.empty()) continue;
+      if (rebase) {
+        offset = validator.newest_time() + options_.batch_us - chunk.t.front();
+        rebase = false;
+      }
+      if (offset != 0) {
+        for (Timestamp& t : chunk.t) t += offset;
+      }
+      validator.filter(chunk);
+      if (chunk.empty()) continue;
+      if (!first_t) first_t = chunk.t.front();
+      batcher.push(chunk);
+      publish_ready(false);
+      if (options_.progress_period_s > 0 &&
+          Clock::now() - last_progress > std::chrono::duration<double>(options_.progress_period_s)) {
+        last_progress = Clock::now();
+        spdlog::info("{:.0f}% of {}: {} events in {} batches, {:.2f} s of event time", 100.0 * source->progress(),
+                     source->name(), summary.events_published, summary.batches,
+                     static_cast<double>(validator.newest_time() - first_t.value_or(0)) * 1e-6);
+      }
+    }
+  } catch (const FormatError& error) {
+    spdlog::error("{} (every event before it was published)", error.what());
+    summary.input_error = error.what();
+  }
+  publish_ready(true);
+  summary.drops = validator.drops();
+  summary.event_seconds = first_t ? static_cast<double>(validator.newest_time() - *first_t) * 1e-6 : 0.0;
+  summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  return summary;
+}
+
+void CameraNode::publish(const EventBatch& batch, CameraSummary& summary) {
+  event_batch_t& msg = msg_;
+  fill_event_batch(batch, msg);
+  msg.utime = wall_clock_us();
+  msg.epoch = epoch_us_;
+  msg.seq = static_cast<std::int64_t>(summary.batches);
+  msg.source = options_.camera;
+  msg.width = static_cast<std::int16_t>(summary.sensor.width);
+  msg.height = static_cast<std::int16_t>(summary.sensor.height);
+  if (lcm_.publish(channel_, &msg) != 0) {
+    // The sequence number still advances: subscribers count the batch as lost.
+    if (std::has_single_bit(++summary.publish_failures)) spdlog::warn("{} batch publish(es) failed", summary.publish_failures);
+  } else {
+    summary.events_published += batch.size();
+    summary.bytes += static_cast<std::uint64_t>(msg.getEncodedSize());
+  }
+  ++summary.batches;
+}
+
+}  // namespace evldt

@@ -1,0 +1,204 @@
+#include "evldt/nodes/lines_node.hpp"
+
+#include <chrono>
+#include <spdlog/spdlog.h>
+#include <stdexcept>
+
+#include "evldt/transport/channels.hpp"
+
+namespace evldt {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+Clock::duration period_of(double hz) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / hz));
+}
+
+}  // namespace
+
+LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch_us)
+    : lcm_(lcm),
+      options_(std::move(options)),
+      epoch_us_(epoch_us),
+      lines_channel_(lines_channel(options_.camera)),
+      receiver_(options_.sensor, options_.time_slack_us),
+      next_line_id_(static_cast<std::uint64_t>(epoch_us)) {
+  batch_.reserve(1 << 16);
+  if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100)) {
+    throw std::invalid_argument("publish rate must be in (0, 10000] Hz and stats rate in (0, 100] Hz");
+  }
+  if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
+  subscription_ = lcm_.subscribe(events_channel(options_.camera), &LinesNode::on_events, this);
+  if (!subscription_) throw std::runtime_error("cannot subscribe to " + events_channel(options_.camera));
+}
+
+LinesNode::~LinesNode() {
+  if (subscription_) lcm_.unsubscribe(subscription_);
+  if (auto engine = this->engine()) engine->stop();
+}
+
+std::shared_ptr<RealtimeEngine> LinesNode::engine() const {
+  std::lock_guard lock(mutex_);
+  return engine_;
+}
+
+void LinesNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
+  const std::span<const std::uint8_t> payload(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size);
+  const bool accepted = receiver_.receive(payload, batch_);
+  if (accepted && (!engine_ || receiver_.restarted())) start_engine();
+  if (accepted && !batch_.empty()) engine_->process(batch_);
+  std::lock_guard lock(mutex_);
+  receiver_counts_ = receiver_.counts();
+  if (accepted && !batch_.empty()) {
+    latency_.batch_stored(receiver_.message().seq, receiver_.message().utime, batch_.t.back());
+  }
+}
+
+void LinesNode::start_engine() {
+  // First batch, or the camera restarted (its clock may begin again): a fresh lattice and lines.
+  EngineCounters retired;
+  if (engine_) {
+    engine_->stop();  // the publisher may still snapshot it meanwhile
+    retired = engine_->counters();
+    spdlog::warn("camera {} restarted (epoch {}): lattice and lines begin afresh", options_.camera,
+                 receiver_.message().epoch);
+  } else {
+    const SensorSize sensor = *receiver_.sensor();
+    spdlog::info("first batch on {}: {}x{} sensor from '{}'", events_channel(options_.camera), sensor.width,
+                 sensor.height, receiver_.message().source);
+  }
+  auto engine = std::make_shared<RealtimeEngine>(options_.configure(*receiver_.sensor()));
+  engine->set_first_line_id(next_line_id_ + retired.lines_created);
+  engine->start();
+  std::lock_guard lock(mutex_);
+  if (engine_) ++engine_restarts_;
+  engine_ = std::move(engine);
+  latency_ = LatencyTracker();
+  next_line_id_ += retired.lines_created;
+  retired_.events += retired.events;
+  retired_.detect_rounds += retired.detect_rounds;
+  retired_.track_rounds += retired.track_rounds;
+  retired_.lines_created += retired.lines_created;
+}
+
+void LinesNode::run(const std::atomic<bool>& stop) {
+  std::thread publisher([&] { publish_loop(stop); });
+  while (!stop.load()) {
+    if (lcm_.handleTimeout(100) < 0 && !stop.load()) {
+      spdlog::error("LCM receive failed; stopping");  // a stop signal interrupting the wait is not a failure
+      break;
+    }
+  }
+  publisher.join();
+  if (auto engine = this->engine()) engine->stop();
+}
+
+void LinesNode::publish_loop(const std::atomic<bool>& stop) {
+  const auto publish_period = period_of(options_.publish_hz);
+  const auto stats_period = period_of(options_.stats_hz);
+  auto next_publish = Clock::now();
+  auto last_stats = next_publish;
+  auto last_log = next_publish;
+  while (!stop.load()) {
+    publish_segments();
+    const auto now = Clock::now();
+    if (now - last_stats >= stats_period) {
+      publish_stats(std::chrono::duration<double>(now - last_stats).count());
+      last_stats = now;
+    }
+    if (options_.log_period_s > 0 && now - last_log >= std::chrono::duration<double>(options_.log_period_s)) {
+      last_log = now;
+      const LinesNodeTotals t = totals();
+      spdlog::info("{} events stored, {} batches ({} lost, {} invalid messages), {} lines created, {} lists published",
+                   t.events_stored, t.receiver.sequence.received, t.receiver.sequence.lost,
+                   t.receiver.invalid_messages, t.lines_created, t.lists_published);
+    }
+    next_publish += publish_period;
+    if (next_publish < now) next_publish = now;  // fell behind: do not burst to catch up
+    std::this_thread::sleep_until(next_publish);
+  }
+}
+
+void LinesNode::publish_segments() {
+  const auto engine = this->engine();
+  if (!engine) return;  // nothing received yet
+  const Timestamp lattice_us = engine->snapshot(lines_);
+  fill_segment_list(lines_, list_msg_);
+  const std::int64_t now = wall_clock_us();
+  LatencyTracker::Included included;
+  {
+    std::lock_guard lock(mutex_);
+    included = latency_.list_published(lattice_us, now);
+  }
+  const SensorSize sensor = engine->geometry().sensor;
+  list_msg_.utime = now;
+  list_msg_.epoch = epoch_us_;
+  list_msg_.seq = list_seq_++;
+  list_msg_.source = options_.camera;
+  list_msg_.width = static_cast<std::int16_t>(sensor.width);
+  list_msg_.height = static_cast<std::int16_t>(sensor.height);
+  list_msg_.t_us = lattice_us;
+  list_msg_.newest_batch_seq = included.seq;
+  list_msg_.newest_batch_utime = included.utime;
+  if (lcm_.publish(lines_channel_, &list_msg_) == 0) lists_published_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void LinesNode::publish_stats(double period_s) {
+  const LinesNodeTotals now = totals();
+  LatencySummary latency;
+  {
+    std::lock_guard lock(mutex_);
+    latency = latency_.take_summary();
+  }
+  const auto rate = [&](std::uint64_t current, std::uint64_t before) {
+    return static_cast<double>(current - before) / period_s;
+  };
+  stats_t msg;
+  msg.utime = wall_clock_us();
+  msg.epoch = epoch_us_;
+  msg.service = "evldt-lines";
+  msg.source = options_.camera;
+  msg.period_s = period_s;
+  msg.events_in = static_cast<std::int64_t>(now.events_stored);
+  msg.event_rate = rate(now.events_stored, last_stats_.events_stored);
+  msg.events_dropped = static_cast<std::int64_t>(now.receiver.drops.total());
+  msg.batches_received = static_cast<std::int64_t>(now.receiver.sequence.received);
+  msg.batches_lost = static_cast<std::int64_t>(now.receiver.sequence.lost);
+  msg.invalid_messages = static_cast<std::int64_t>(now.receiver.invalid_messages);
+  msg.detect_hz = rate(now.detect_rounds, last_stats_.detect_rounds);
+  msg.track_hz = rate(now.track_rounds, last_stats_.track_rounds);
+  msg.live_lines = static_cast<std::int32_t>(lines_.size());
+  msg.lists_published = static_cast<std::int64_t>(now.lists_published);
+  msg.latency_samples = static_cast<std::int32_t>(latency.samples);
+  msg.latency_median_ms = static_cast<float>(latency.median_ms);
+  msg.latency_p99_ms = static_cast<float>(latency.p99_ms);
+  lcm_.publish(std::string(kStatsChannel), &msg);
+  last_stats_ = now;
+}
+
+LinesNodeTotals LinesNode::totals() const {
+  LinesNodeTotals totals;
+  std::shared_ptr<RealtimeEngine> engine;
+  {
+    std::lock_guard lock(mutex_);
+    engine = engine_;
+    totals.receiver = receiver_counts_;
+    totals.engine_restarts = engine_restarts_;
+    totals.events_stored = retired_.events;
+    totals.detect_rounds = retired_.detect_rounds;
+    totals.track_rounds = retired_.track_rounds;
+    totals.lines_created = retired_.lines_created;
+  }
+  if (engine) {
+    const EngineCounters counters = engine->counters();
+    totals.events_stored += counters.events;
+    totals.detect_rounds += counters.detect_rounds;
+    totals.track_rounds += counters.track_rounds;
+    totals.lines_created += counters.lines_created;
+  }
+  totals.lists_published = lists_published_.load(std::memory_order_relaxed);
+  return totals;
+}
+
+}  // namespace evldt

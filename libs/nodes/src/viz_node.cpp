@@ -1,0 +1,123 @@
+#include "evldt/nodes/viz_node.hpp"
+
+#include <bit>
+#include <chrono>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+#include <stdexcept>
+
+#include "evldt/transport/channels.hpp"
+
+namespace evldt {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::span<const std::uint8_t> payload_of(const lcm::ReceiveBuffer* buffer) {
+  return {static_cast<const std::uint8_t*>(buffer->data), buffer->data_size};
+}
+
+void put_line(cv::Mat& canvas, const std::string& text, int row) {
+  const cv::Point origin(6, 16 + 18 * row);
+  cv::putText(canvas, text, origin, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+  cv::putText(canvas, text, origin, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+}
+
+}  // namespace
+
+VizNode::VizNode(lcm::LCM& lcm, VizNodeOptions options)
+    : lcm_(lcm), options_(std::move(options)), receiver_(options_.sensor, options_.time_slack_us) {
+  if (!(options_.render_hz > 0 && options_.render_hz <= 1000)) throw std::invalid_argument("render rate must be in (0, 1000] Hz");
+  if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
+  subscriptions_.push_back(lcm_.subscribe(events_channel(options_.camera), &VizNode::on_events, this));
+  subscriptions_.push_back(lcm_.subscribe(lines_channel(options_.camera), &VizNode::on_lines, this));
+  subscriptions_.push_back(lcm_.subscribe(std::string(kStatsChannel), &VizNode::on_stats, this));
+}
+
+VizNode::~VizNode() {
+  for (auto* subscription : subscriptions_) {
+    if (subscription) lcm_.unsubscribe(subscription);
+  }
+}
+
+void VizNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
+  if (!receiver_.receive(payload_of(buffer), batch_)) return;
+  if (!lattice_ || receiver_.restarted()) {
+    const LatticeParams params = default_config_for(*receiver_.sensor()).lattice;
+    lattice_.emplace(params.sensor, params.block_size, params.alpha, /*keep_surface=*/true);
+  }
+  for (std::size_t i = 0; i < batch_.size(); ++i) lattice_->insert(batch_.x[i], batch_.y[i]);
+  events_since_frame_ += batch_.size();
+}
+
+void VizNode::on_lines(const lcm::ReceiveBuffer* buffer, const std::string&) {
+  if (decode_message(payload_of(buffer), lines_msg_) != WireError::None || !read_segment_list(lines_msg_, lines_)) {
+    if (std::has_single_bit(++totals_.invalid_segment_lists)) {
+      spdlog::warn("refused {} invalid segment list(s)", totals_.invalid_segment_lists);
+    }
+    lines_.clear();
+    return;
+  }
+  lines_t_us_ = lines_msg_.t_us;
+  ++totals_.segment_lists;
+}
+
+void VizNode::on_stats(const lcm::ReceiveBuffer* buffer, const std::string&) {
+  // Statistics of other cameras' lines services share the channel: keep only ours.
+  if (decode_message(payload_of(buffer), stats_msg_) == WireError::None && stats_msg_.source == options_.camera) {
+    stats_ = stats_msg_;
+    ++totals_.stats;
+  }
+}
+
+void VizNode::render(cv::Mat& canvas) {
+  const SensorSize sensor = *receiver_.sensor();
+  render_scene(sensor, lattice_->surface(), lines_, options_.render, canvas);
+  const ReceiverCounts counts = receiver_.counts();
+  put_line(canvas,
+           fmt::format("{}  t={:.3f}s  {:.2f} Mev/s  {} lines", options_.camera, static_cast<double>(lines_t_us_) * 1e-6,
+                       event_rate_ * 1e-6, lines_.size()),
+           0);
+  if (stats_) {
+    put_line(canvas,
+             fmt::format("detect {:.0f} Hz  track {:.0f} Hz  latency {:.1f}/{:.1f} ms  lost {}", stats_->detect_hz,
+                         stats_->track_hz, stats_->latency_median_ms, stats_->latency_p99_ms, stats_->batches_lost),
+             1);
+  } else {
+    put_line(canvas, "no statistics from evldt-lines yet", 1);
+  }
+  if (counts.sequence.lost || counts.invalid_messages) {
+    put_line(canvas, fmt::format("viz: {} batches lost, {} invalid", counts.sequence.lost, counts.invalid_messages), 2);
+  }
+}
+
+void VizNode::run(const std::atomic<bool>& stop, const FrameHandler& on_frame) {
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / options_.render_hz));
+  auto next_frame = Clock::now() + period;
+  auto last_rate = Clock::now();
+  cv::Mat canvas;
+  while (!stop.load()) {
+    const auto now = Clock::now();
+    if (now >= next_frame) {
+      next_frame = std::max(next_frame + period, now);
+      const double elapsed = std::chrono::duration<double>(now - last_rate).count();
+      event_rate_ = static_cast<double>(events_since_frame_) / elapsed;
+      events_since_frame_ = 0;
+      last_rate = now;
+      if (lattice_) {
+        render(canvas);
+        ++totals_.frames;
+        if (!on_frame(canvas)) break;
+      }
+      continue;
+    }
+    const auto wait_ms = std::chrono::duration_cast<std::chrono::milliseconds>(next_frame - now).count();
+    if (lcm_.handleTimeout(static_cast<int>(std::clamp<long long>(wait_ms, 1, 100))) < 0 && !stop.load()) {
+      spdlog::error("LCM receive failed; stopping");  // a stop signal interrupting the wait is not a failure
+      break;
+    }
+  }
+  totals_.events = receiver_.counts();
+}
+
+}  // namespace evldt

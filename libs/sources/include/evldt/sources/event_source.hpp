@@ -1,0 +1,52 @@
+#pragma once
+// Where events come from, behind one interface: a recording file (ECD text, EVT 2.0/3.0, .dat, or
+// an lcm-log of event batches), a built-in simulated scene, or a video file / webcam turned into
+// events by frame differencing. The offline runner and the camera service read through it.
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "evldt/events/event.hpp"
+#include "evldt/events/event_format.hpp"
+#include "evldt/sim/event_simulator.hpp"
+#include "evldt/sim/frame_difference.hpp"
+
+namespace evldt {
+
+class EventSource {
+ public:
+  virtual ~EventSource() = default;
+  /// Clears `batch` and fills it with the next events in time order; false at the end. A corrupt
+  /// recording throws FormatError after its valid prefix has been returned.
+  virtual bool read(EventBatch& batch) = 0;
+  /// The sensor size, where the source knows it (some recordings' headers do not say).
+  [[nodiscard]] virtual std::optional<SensorSize> geometry() const = 0;
+  /// Fraction done, in [0, 1] (0 for a live camera).
+  [[nodiscard]] virtual double progress() const = 0;
+  [[nodiscard]] const std::string& name() const { return name_; }
+
+ protected:
+  std::string name_;
+};
+
+/// A recording; an lcm-log is recognised by its content, the other formats by name or `format`.
+/// `lcm_channel` picks the event channel of an lcm-log (empty: the first EVENTS_* channel), whose
+/// batches are checked as a subscriber checks them (`backwards_slack_us` for their time order).
+std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, std::optional<EventFormat> format,
+                                            const std::string& lcm_channel, Timestamp backwards_slack_us);
+/// A scene run through the event simulator; `label` names it in logs.
+std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label);
+
+struct VideoSourceOptions {
+  std::string input;              ///< a video file, or a webcam index ("0")
+  FrameDifferenceConfig emulator;
+  double fps_override = 0;        ///< frame rate to assume where the file does not say (0: ask the file, else 30)
+};
+/// Frames of a video file or webcam, as events by frame differencing. Throws std::runtime_error if
+/// it cannot be opened. A file's frame times come from its frame rate (deterministic); a webcam's
+/// from the wall clock.
+std::unique_ptr<EventSource> open_video(const VideoSourceOptions& options);
+
+}  // namespace evldt

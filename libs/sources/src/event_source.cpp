@@ -1,0 +1,154 @@
+#include "evldt/sources/event_source.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <stdexcept>
+
+#include "evldt/events/event_reader.hpp"
+#include <spdlog/spdlog.h>
+#include "evldt/transport/lcm_log.hpp"
+
+namespace evldt {
+namespace {
+
+class RecordingSource final : public EventSource {
+ public:
+  RecordingSource(const std::filesystem::path& path, std::optional<EventFormat> format) : reader_(path, format) {
+    name_ = path.string() + " (" + std::string(format_name(reader_.format())) + ")";
+  }
+  bool read(EventBatch& batch) override { return reader_.read(batch); }
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return reader_.geometry(); }
+  [[nodiscard]] double progress() const override {
+    return static_cast<double>(reader_.bytes_read()) / static_cast<double>(std::max<std::uint64_t>(1, reader_.file_size()));
+  }
+
+ private:
+  EventFileReader reader_;
+};
+
+class LcmLogSource final : public EventSource {
+ public:
+  LcmLogSource(const std::filesystem::path& path, const std::string& channel, Timestamp backwards_slack_us)
+      : reader_(path, channel, backwards_slack_us) {
+    name_ = path.string() + " (lcm-log, " + reader_.channel() + ")";
+  }
+  ~LcmLogSource() override {
+    const ReceiverCounts counts = reader_.counts();
+    if (counts.sequence.lost || counts.invalid_messages) {
+      spdlog::warn("{}: {} batches missing by sequence number, {} invalid messages skipped", name_,
+                   counts.sequence.lost, counts.invalid_messages);
+    }
+  }
+  bool read(EventBatch& batch) override { return reader_.read(batch); }
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return reader_.sensor(); }
+  [[nodiscard]] double progress() const override { return reader_.progress(); }
+
+ private:
+  LcmLogEventReader reader_;
+};
+
+class SceneSource final : public EventSource {
+ public:
+  SceneSource(Scene scene, const SimulatorConfig& config, const std::string& label)
+      : simulator_(std::move(scene), config) {
+    name_ = "scene " + label;
+  }
+  bool read(EventBatch& batch) override {
+    batch.clear();
+    constexpr Timestamp kSliceUs = 10000;
+    return simulator_.run_until(simulator_.now_us() + kSliceUs, batch);
+  }
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return simulator_.scene().sensor; }
+  [[nodiscard]] double progress() const override {
+    return static_cast<double>(simulator_.now_us()) / static_cast<double>(simulator_.scene().duration_us);
+  }
+
+ private:
+  EventSimulator simulator_;
+};
+
+class VideoSource final : public EventSource {
+ public:
+  explicit VideoSource(const VideoSourceOptions& options) {
+    int index = -1;
+    const auto& input = options.input;
+    const auto [end, error] = std::from_chars(input.data(), input.data() + input.size(), index);
+    live_ = error == std::errc() && end == input.data() + input.size();
+    const bool opened = live_ ? capture_.open(index) : capture_.open(input);
+    if (!opened) throw std::runtime_error("cannot open video " + std::string(live_ ? "camera " : "file ") + input);
+    if (!live_) frame_count_ = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+    const double file_fps = capture_.get(cv::CAP_PROP_FPS);
+    fps_ = options.fps_override > 0 ? options.fps_override : (file_fps > 0 && file_fps < 10000 ? file_fps : 30.0);
+    if (!capture_.read(frame_) || frame_.empty()) throw std::runtime_error("no frame in video " + input);
+    sensor_ = {frame_.cols, frame_.rows};
+    emulator_.emplace(sensor_, options.emulator);
+    name_ = "video " + input + " (" + std::to_string(sensor_.width) + "x" + std::to_string(sensor_.height) +
+            ", frame differencing)";
+    started_ = std::chrono::steady_clock::now();
+    add_frame(nullptr);  // the first frame only sets the reference
+  }
+  bool read(EventBatch& batch) override {
+    batch.clear();
+    while (batch.empty()) {  // a static scene gives frames without events
+      if (!capture_.read(frame_) || frame_.empty()) return false;
+      if (frame_.cols != sensor_.width || frame_.rows != sensor_.height) {
+        throw std::runtime_error(name_ + ": frame size changed mid-stream");
+      }
+      add_frame(&batch);
+    }
+    return true;
+  }
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return sensor_; }
+  [[nodiscard]] double progress() const override {
+    return frame_count_ > 0 ? std::min(1.0, static_cast<double>(frames_) / frame_count_) : 0.0;
+  }
+
+ private:
+  void add_frame(EventBatch* out) {
+    if (frame_.channels() == 1) {
+      frame_.copyTo(grey_);
+    } else {
+      cv::cvtColor(frame_, grey_, frame_.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+    }
+    if (grey_.depth() != CV_8U) grey_.convertTo(grey_, CV_8U);
+    const Timestamp t = live_ ? std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - started_).count()
+                              : static_cast<Timestamp>(static_cast<double>(frames_) * 1e6 / fps_);
+    // Frame times must increase; a webcam may deliver two frames within a microsecond.
+    const Timestamp frame_t = std::max(t, last_t_ + 1);
+    last_t_ = frame_t;
+    ++frames_;
+    EventBatch discard;
+    emulator_->add_frame(std::span<const std::uint8_t>(grey_.ptr<std::uint8_t>(), grey_.total()), frame_t,
+                         out ? *out : discard);
+  }
+
+  cv::VideoCapture capture_;
+  bool live_ = false;
+  double fps_ = 30;
+  double frame_count_ = 0;
+  SensorSize sensor_;
+  std::optional<FrameDifferenceEmulator> emulator_;
+  cv::Mat frame_, grey_;
+  std::uint64_t frames_ = 0;
+  Timestamp last_t_ = -1;
+  std::chrono::steady_clock::time_point started_;
+};
+
+}  // namespace
+
+std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, std::optional<EventFormat> format,
+                                            const std::string& lcm_channel, Timestamp backwards_slack_us) {
+  if (!format && is_lcm_log(path)) return std::make_unique<LcmLogSource>(path, lcm_channel, backwards_slack_us);
+  return std::make_unique<RecordingSource>(path, format);
+}
+
+std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label) {
+  return std::make_unique<SceneSource>(std::move(scene), config, label);
+}
+
+std::unique_ptr<EventSource> open_video(const VideoSourceOptions& options) { return std::make_unique<VideoSource>(options); }
+
+}  // namespace evldt

@@ -1,0 +1,25 @@
+#pragma once
+// LCM channel names (upper case, one set per camera) and the wall clock messages are stamped with.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace evldt {
+
+inline constexpr std::string_view kStatsChannel = "EVLDT_STATS";
+/// The default URL: multicast on this host only (ttl=0); ttl=1 reaches the robot's LAN.
+inline constexpr std::string_view kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
+
+/// "front" -> "EVENTS_FRONT".
+std::string events_channel(std::string_view camera);
+/// "front" -> "LINES_FRONT".
+std::string lines_channel(std::string_view camera);
+/// Throws std::invalid_argument unless the camera name is 1-32 letters, digits or '_'.
+void check_camera_name(std::string_view camera);
+
+/// Microseconds since the Unix epoch (comparable across processes; across hosts only as far as
+/// their clocks are synchronised).
+std::int64_t wall_clock_us();
+
+}  // namespace evldt

@@ -1,0 +1,52 @@
+#pragma once
+// The receiving end of an event channel, shared by every subscriber (lines, viz, lcm-log reader):
+// every payload is decoded with checks, its sensor size compared, its sequence number accounted and
+// its events validated. Whatever is refused is counted and logged, never fatal.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include "evldt/events/event_validator.hpp"
+#include "evldt/transport/messages.hpp"
+#include "evldt/transport/sequence_tracker.hpp"
+
+namespace evldt {
+
+struct ReceiverCounts {
+  std::uint64_t invalid_messages = 0;  ///< undecodable, foreign type, bad sensor size or time base
+  SequenceCounts sequence;
+  DropCounts drops;                    ///< events refused by the validator (before a restart included)
+};
+
+class EventBatchReceiver {
+ public:
+  /// `sensor`: the size batches must have; unset: the first valid batch's size is adopted.
+  EventBatchReceiver(std::optional<SensorSize> sensor, Timestamp backwards_slack_us);
+
+  /// Decodes `payload`; if it is a valid, current batch, fills `out` (cleared) with its valid
+  /// events and returns true (`out` may then be empty). A batch of a newer publisher epoch
+  /// restarts the time-order check (restarted() tells).
+  bool receive(std::span<const std::uint8_t> payload, EventBatch& out);
+
+  /// Header of the last accepted batch.
+  [[nodiscard]] const event_batch_t& message() const { return message_; }
+  [[nodiscard]] std::optional<SensorSize> sensor() const { return sensor_; }
+  /// True if the last accepted batch started a new publisher epoch (not for the first batch).
+  [[nodiscard]] bool restarted() const { return restarted_; }
+  [[nodiscard]] ReceiverCounts counts() const;
+
+ private:
+  void refuse(const char* why);
+
+  std::optional<SensorSize> sensor_;
+  Timestamp slack_;
+  std::optional<EventValidator> validator_;
+  DropCounts drops_before_restart_;
+  SequenceTracker sequence_;
+  std::uint64_t invalid_ = 0;
+  event_batch_t message_;
+  bool restarted_ = false;
+};
+
+}  // namespace evldt

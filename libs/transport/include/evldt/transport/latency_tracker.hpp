@@ -1,0 +1,52 @@
+#pragma once
+// End-to-end latency of the lines service: from an event batch's publish (camera wall clock) to the
+// publish of the first segment list whose lattice state holds all its events. Fixed memory: a ring
+// of batches waiting to be included and a bounded sample store per reporting period.
+
+#include <cstdint>
+#include <vector>
+
+#include "evldt/events/event.hpp"
+
+namespace evldt {
+
+struct LatencySummary {
+  std::uint32_t samples = 0;
+  double median_ms = 0;
+  double p99_ms = 0;
+};
+
+class LatencyTracker {
+ public:
+  /// `pending_capacity`: batches that may wait for a list (the oldest is forgotten beyond it);
+  /// `sample_capacity`: latencies kept per period (later ones in the period are not kept).
+  explicit LatencyTracker(std::size_t pending_capacity = 16384, std::size_t sample_capacity = 65536);
+
+  /// A batch was stored: its sequence number, publish wall clock and newest event time.
+  void batch_stored(std::int64_t seq, std::int64_t publish_utime, Timestamp newest_event_us);
+
+  struct Included {
+    std::int64_t seq = -1;    ///< newest batch included so far (-1: none yet)
+    std::int64_t utime = 0;   ///< its publish wall clock
+  };
+  /// A segment list of lattice time `lattice_us` is published at `now_utime`: records the latency
+  /// of every waiting batch it includes and returns the newest batch included so far.
+  Included list_published(Timestamp lattice_us, std::int64_t now_utime);
+
+  /// Median and p99 of the latencies recorded since the previous call.
+  LatencySummary take_summary();
+
+ private:
+  struct Pending {
+    std::int64_t seq;
+    std::int64_t utime;
+    Timestamp newest_event_us;
+  };
+  std::vector<Pending> ring_;
+  std::size_t head_ = 0, count_ = 0;
+  std::vector<double> samples_ms_;
+  std::size_t sample_capacity_;
+  Included newest_;
+};
+
+}  // namespace evldt

@@ -1,0 +1,46 @@
+#pragma once
+// Between the core's types and the LCM messages. Decoding from the wire is checked first: the code
+// lcm-gen writes trusts length fields (a forged count makes it allocate gigabytes before it notices
+// the bytes are missing), so every length is checked against the bytes actually received. The
+// generated types share the namespace evldt (the LCM package) with the core.
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "evldt/events/event.hpp"
+#include "evldt/lines/line_map.hpp"
+#include "evldt/event_batch_t.hpp"
+#include "evldt/segment_list_t.hpp"
+#include "evldt/stats_t.hpp"
+
+namespace evldt {
+
+/// Bytes of one event in an event_batch_t (int32 dt, int16 x, int16 y, int8 polarity).
+inline constexpr std::size_t kEventWireBytes = 9;
+/// Largest event-time span of one batch (dt is int32).
+inline constexpr Timestamp kMaxBatchSpanUs = INT32_MAX;
+
+/// Why a payload was refused.
+enum class WireError : std::uint8_t { None, WrongType, Malformed };
+std::string_view wire_error_name(WireError error);
+
+/// Decodes `bytes` into `out` if, and only if, it is a complete, well-formed message of that type.
+WireError decode_message(std::span<const std::uint8_t> bytes, event_batch_t& out);
+WireError decode_message(std::span<const std::uint8_t> bytes, segment_list_t& out);
+WireError decode_message(std::span<const std::uint8_t> bytes, stats_t& out);
+
+/// Fills the event arrays and time base of `msg` from `events` (header fields are the caller's).
+/// Throws std::invalid_argument if an event lies more than kMaxBatchSpanUs from the first.
+void fill_event_batch(const EventBatch& events, event_batch_t& msg);
+/// Appends the events of `msg` to `out`. Coordinates and times are not judged here (the event
+/// validator drops and counts those); false, with nothing appended, if the time base is out of range.
+bool read_event_batch(const event_batch_t& msg, EventBatch& out);
+
+/// Fills the segments of `msg` (header fields are the caller's).
+void fill_segment_list(std::span<const TrackedLine> lines, segment_list_t& msg);
+/// Replaces `out` with the segments of `msg`; false if any has an unknown status or a non-finite value.
+bool read_segment_list(const segment_list_t& msg, std::vector<TrackedLine>& out);
+
+}  // namespace evldt

@@ -1,0 +1,30 @@
+#pragma once
+// Loss accounting for a stream of numbered messages (DESIGN 7): a gap in the sequence is lost
+// messages; a newer publisher epoch (a restarted camera) starts the count afresh.
+
+#include <cstdint>
+
+namespace evldt {
+
+struct SequenceCounts {
+  std::uint64_t received = 0;
+  std::uint64_t lost = 0;          ///< sequence numbers skipped
+  std::uint64_t late = 0;          ///< duplicates, out of order, or from an older epoch (not used)
+  std::uint64_t restarts = 0;      ///< publisher epochs seen after the first
+};
+
+class SequenceTracker {
+ public:
+  /// Accounts one message; returns false if it is late (a duplicate, reordered, or of an older
+  /// epoch) and should be ignored.
+  bool observe(std::int64_t epoch, std::int64_t seq);
+  [[nodiscard]] const SequenceCounts& counts() const { return counts_; }
+
+ private:
+  bool started_ = false;
+  std::int64_t epoch_ = 0;
+  std::int64_t expected_ = 0;
+  SequenceCounts counts_;
+};
+
+}  // namespace evldt

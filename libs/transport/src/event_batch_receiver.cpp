@@ -1,0 +1,64 @@
+#include "evldt/transport/event_batch_receiver.hpp"
+
+#include <bit>
+#include <spdlog/spdlog.h>
+
+namespace evldt {
+
+EventBatchReceiver::EventBatchReceiver(std::optional<SensorSize> sensor, Timestamp backwards_slack_us)
+    : sensor_(sensor), slack_(backwards_slack_us) {
+  if (sensor_) validator_.emplace(*sensor_, slack_);
+}
+
+void EventBatchReceiver::refuse(const char* why) {
+  if (std::has_single_bit(++invalid_)) spdlog::warn("refused {} event message(s) (latest: {})", invalid_, why);
+}
+
+bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBatch& out) {
+  out.clear();
+  if (const WireError error = decode_message(payload, message_); error != WireError::None) {
+    refuse(error == WireError::WrongType ? "not an evldt event_batch_t" : "malformed event_batch_t");
+    return false;
+  }
+  const SensorSize size{message_.width, message_.height};
+  if (!size.valid()) {
+    refuse("invalid sensor size");
+    return false;
+  }
+  if (sensor_ && size != *sensor_) {
+    refuse("sensor size differs from the stream's");
+    return false;
+  }
+  const std::uint64_t restarts_before = sequence_.counts().restarts;
+  if (!sequence_.observe(message_.epoch, message_.seq)) return false;
+  restarted_ = sequence_.counts().restarts != restarts_before;
+  if (!read_event_batch(message_, out)) {
+    refuse("time base out of range");
+    return false;
+  }
+  if (!sensor_) sensor_ = size;
+  if (!validator_ || restarted_) {
+    // A restarted camera's clock may begin again: judge its time order afresh.
+    if (validator_) {
+      drops_before_restart_.off_sensor += validator_->drops().off_sensor;
+      drops_before_restart_.time_backwards += validator_->drops().time_backwards;
+    }
+    validator_.emplace(*sensor_, slack_);
+  }
+  validator_->filter(out);
+  return true;
+}
+
+ReceiverCounts EventBatchReceiver::counts() const {
+  ReceiverCounts counts;
+  counts.invalid_messages = invalid_;
+  counts.sequence = sequence_.counts();
+  counts.drops = drops_before_restart_;
+  if (validator_) {
+    counts.drops.off_sensor += validator_->drops().off_sensor;
+    counts.drops.time_backwards += validator_->drops().time_backwards;
+  }
+  return counts;
+}
+
+}  // namespace evldt

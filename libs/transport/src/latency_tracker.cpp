@@ -1,0 +1,52 @@
+#include "evldt/transport/latency_tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace evldt {
+
+LatencyTracker::LatencyTracker(std::size_t pending_capacity, std::size_t sample_capacity)
+    : ring_(std::max<std::size_t>(pending_capacity, 1)), sample_capacity_(sample_capacity) {
+  samples_ms_.reserve(sample_capacity);
+}
+
+void LatencyTracker::batch_stored(std::int64_t seq, std::int64_t publish_utime, Timestamp newest_event_us) {
+  if (count_ == ring_.size()) {  // forget the oldest
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+  }
+  ring_[(head_ + count_) % ring_.size()] = {seq, publish_utime, newest_event_us};
+  ++count_;
+}
+
+LatencyTracker::Included LatencyTracker::list_published(Timestamp lattice_us, std::int64_t now_utime) {
+  // Batches arrive in event-time order, so the included ones are a prefix of the ring.
+  while (count_ > 0 && ring_[head_].newest_event_us <= lattice_us) {
+    const Pending& batch = ring_[head_];
+    if (samples_ms_.size() < sample_capacity_) {
+      samples_ms_.push_back(static_cast<double>(now_utime - batch.utime) * 1e-3);
+    }
+    newest_ = {batch.seq, batch.utime};
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+  }
+  return newest_;
+}
+
+LatencySummary LatencyTracker::take_summary() {
+  LatencySummary summary;
+  summary.samples = static_cast<std::uint32_t>(samples_ms_.size());
+  if (!samples_ms_.empty()) {
+    const auto quantile = [&](double q) {
+      const auto k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(samples_ms_.size()))) - 1;
+      std::nth_element(samples_ms_.begin(), samples_ms_.begin() + static_cast<std::ptrdiff_t>(k), samples_ms_.end());
+      return samples_ms_[k];
+    };
+    summary.median_ms = quantile(0.5);
+    summary.p99_ms = quantile(0.99);
+  }
+  samples_ms_.clear();
+  return summary;
+}
+
+}  // namespace evldt

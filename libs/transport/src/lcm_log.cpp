@@ -1,0 +1,123 @@
+#include "evldt/transport/lcm_log.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
+#include <stdexcept>
+
+#include "evldt/transport/messages.hpp"
+
+namespace evldt {
+namespace {
+
+std::unique_ptr<lcm::LogFile> open_log(const std::filesystem::path& path) {
+  auto log = std::make_unique<lcm::LogFile>(path.string(), "r");
+  if (!log->good()) throw std::runtime_error("cannot open LCM log " + path.string());
+  return log;
+}
+
+bool channel_matches(const std::string& wanted, std::string_view prefix, const std::string& channel) {
+  return wanted.empty() ? channel.starts_with(prefix) : channel == wanted;
+}
+
+std::span<const std::uint8_t> payload(const lcm::LogEvent& event) {
+  return {static_cast<const std::uint8_t*>(event.data), static_cast<std::size_t>(std::max(event.datalen, 0))};
+}
+
+// LogFile stops at the first event it cannot read; say so if that was before the end of the file.
+void report_unread_tail(lcm::LogFile& log, const std::filesystem::path& path) {
+  const long position = std::ftell(log.getFilePtr());
+  std::error_code error;
+  const auto size = std::filesystem::file_size(path, error);
+  if (!error && position >= 0 && static_cast<std::uintmax_t>(position) < size) {
+    spdlog::warn("{}: log unreadable from byte {} of {} (truncated or corrupt); everything before it was read",
+                 path.string(), position, size);
+  }
+}
+
+}  // namespace
+
+bool is_lcm_log(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char magic[4] = {};
+  return in.read(reinterpret_cast<char*>(magic), 4) && magic[0] == 0xED && magic[1] == 0xA1 && magic[2] == 0xDA &&
+         magic[3] == 0x01;
+}
+
+LcmLogEventReader::LcmLogEventReader(const std::filesystem::path& path, std::string channel,
+                                     Timestamp backwards_slack_us)
+    : path_(path), channel_(std::move(channel)), receiver_(std::nullopt, backwards_slack_us) {
+  log_ = open_log(path_);
+  std::error_code error;
+  file_size_ = std::filesystem::file_size(path_, error);
+  if (!next_batch(first_)) {
+    throw std::runtime_error("no valid event batch on " + (channel_.empty() ? std::string("an EVENTS_* channel") : channel_) +
+                             " in LCM log " + path_.string());
+  }
+  first_pending_ = true;
+}
+
+LcmLogEventReader::~LcmLogEventReader() = default;
+
+bool LcmLogEventReader::next_batch(EventBatch& out) {
+  while (const lcm::LogEvent* event = log_->readNextEvent()) {
+    if (!channel_matches(channel_, "EVENTS_", event->channel)) continue;
+    if (!receiver_.receive(payload(*event), out)) continue;
+    if (channel_.empty()) channel_ = event->channel;
+    return true;
+  }
+  report_unread_tail(*log_, path_);
+  return false;
+}
+
+bool LcmLogEventReader::read(EventBatch& out) {
+  if (first_pending_) {
+    first_pending_ = false;
+    out = first_;
+    return true;
+  }
+  return next_batch(out);
+}
+
+double LcmLogEventReader::progress() const {
+  const long position = std::ftell(log_->getFilePtr());
+  return file_size_ && position > 0 ? static_cast<double>(position) / static_cast<double>(file_size_) : 0.0;
+}
+
+std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std::string channel) {
+  const auto log = open_log(path);
+  std::vector<SegmentRow> rows;
+  std::uint64_t invalid = 0;
+  segment_list_t msg;
+  std::vector<TrackedLine> lines;
+  std::size_t step_begin = 0;
+  Timestamp step_t = INT64_MIN;
+  while (const lcm::LogEvent* event = log->readNextEvent()) {
+    if (!channel_matches(channel, "LINES_", event->channel)) continue;
+    if (decode_message(payload(*event), msg) != WireError::None || !read_segment_list(msg, lines)) {
+      ++invalid;
+      continue;
+    }
+    if (channel.empty()) channel = event->channel;
+    // Lists are published at a fixed rate: one of the same lattice time as the previous replaces it.
+    if (msg.t_us == step_t) {
+      rows.resize(step_begin);
+    } else if (!rows.empty() && msg.t_us < step_t) {
+      ++invalid;  // back in time (a restarted lines service): steps must stay ordered
+      continue;
+    }
+    step_begin = rows.size();
+    step_t = msg.t_us;
+    std::sort(lines.begin(), lines.end(), [](const TrackedLine& a, const TrackedLine& b) { return a.id < b.id; });
+    for (const TrackedLine& line : lines) {
+      rows.push_back({msg.t_us, line.id, line.segment, line.score, line.status});
+    }
+  }
+  report_unread_tail(*log, path);
+  if (invalid) spdlog::warn("{}: {} invalid segment lists skipped", path.string(), invalid);
+  if (channel.empty()) throw std::runtime_error("no valid segment list on a LINES_* channel in LCM log " + path.string());
+  return rows;
+}
+
+}  // namespace evldt
