@@ -51,13 +51,14 @@ void VizNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
 }
 
 void VizNode::on_lines(const lcm::ReceiveBuffer* buffer, const std::string&) {
-  if (decode_message(payload_of(buffer), lines_msg_) != WireError::None || !read_segment_list(lines_msg_, lines_)) {
+  // An invalid list is refused whole; the last valid one stays on screen.
+  if (decode_message(payload_of(buffer), lines_msg_) != WireError::None || !read_segment_list(lines_msg_, incoming_)) {
     if (std::has_single_bit(++totals_.invalid_segment_lists)) {
       spdlog::warn("refused {} invalid segment list(s)", totals_.invalid_segment_lists);
     }
-    lines_.clear();
     return;
   }
+  lines_.swap(incoming_);
   lines_t_us_ = lines_msg_.t_us;
   ++totals_.segment_lists;
 }

@@ -61,7 +61,7 @@ class VizNode {
   std::uint64_t events_since_frame_ = 0;
   double event_rate_ = 0;
   segment_list_t lines_msg_;
-  std::vector<TrackedLine> lines_;
+  std::vector<TrackedLine> lines_, incoming_;
   Timestamp lines_t_us_ = 0;
   stats_t stats_msg_;
   std::optional<stats_t> stats_;

@@ -1,0 +1,283 @@
+// The service nodes wired together in one process over LCM's in-memory transport (memq://): the
+// same code paths as the real processes, without sockets.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <lcm/lcm-cpp.hpp>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <thread>
+
+#include "evldt/nodes/camera_node.hpp"
+#include "evldt/nodes/lines_node.hpp"
+#include "evldt/nodes/viz_node.hpp"
+#include "evldt/sim/scenes.hpp"
+#include "evldt/transport/messages.hpp"
+
+namespace evldt {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Records every segment list published on a channel.
+class ListCollector {
+ public:
+  ListCollector(lcm::LCM& lcm, const std::string& channel) { lcm.subscribe(channel, &ListCollector::on_list, this); }
+  void on_list(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    segment_list_t msg;
+    const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size);
+    std::lock_guard lock(mutex_);
+    if (decode_message(bytes, msg) == WireError::None) {
+      lists_.push_back(msg);
+    } else {
+      ++invalid_;
+    }
+  }
+  std::vector<segment_list_t> lists() const {
+    std::lock_guard lock(mutex_);
+    return lists_;
+  }
+  int invalid() const {
+    std::lock_guard lock(mutex_);
+    return invalid_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<segment_list_t> lists_;
+  int invalid_ = 0;
+};
+
+template <typename Condition>
+bool wait_for(Condition condition, std::chrono::milliseconds limit = 20000ms) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(5ms);
+  }
+  return true;
+}
+
+CameraNode::SourceFactory scene_source(const std::string& name, Timestamp duration_us) {
+  return [=] {
+    Scene scene = make_scene(name);
+    scene.duration_us = duration_us;
+    return open_scene(std::move(scene), SimulatorConfig{}, name);
+  };
+}
+
+CameraNodeOptions fast_camera() {
+  CameraNodeOptions options;
+  options.speed = 0;  // as fast as possible: memq queues everything
+  options.progress_period_s = 0;
+  return options;
+}
+
+LinesNodeOptions quiet_lines() {
+  LinesNodeOptions options;
+  options.publish_hz = 500;
+  options.log_period_s = 0;
+  return options;
+}
+
+// Runs a lines node on its own thread for the lifetime of the object.
+class RunningLines {
+ public:
+  RunningLines(lcm::LCM& lcm, std::int64_t epoch) : node(lcm, quiet_lines(), epoch), thread_([this] { node.run(stop_); }) {}
+  ~RunningLines() { stop(); }
+  void stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  LinesNode node;
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+void publish_raw(lcm::LCM& lcm, const std::string& channel, const std::vector<std::uint8_t>& bytes) {
+  ASSERT_EQ(lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size())), 0);
+}
+
+template <typename Message>
+std::vector<std::uint8_t> encode(const Message& msg) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  ListCollector collector(lcm, "LINES_CAM0");
+  constexpr std::int64_t kEpoch = 5'000'000;
+  RunningLines lines(lcm, kEpoch);
+  CameraNode camera(lcm, fast_camera(), 77);
+  const std::atomic<bool> never{false};
+  const CameraSummary sent = camera.run(scene_source("boxes-6dof", 400'000), never);
+  ASSERT_GT(sent.batches, 300u);
+  ASSERT_EQ(sent.events_published, sent.events_read);
+  EXPECT_NEAR(static_cast<double>(sent.bytes) / static_cast<double>(sent.events_published), 9.0, 1.0);
+
+  // Eventually a list includes the last batch: every event reached the lattice and was tracked on.
+  const auto last_seq = static_cast<std::int64_t>(sent.batches - 1);
+  ASSERT_TRUE(wait_for([&] {
+    const auto lists = collector.lists();
+    return !lists.empty() && lists.back().newest_batch_seq == last_seq;
+  }));
+  lines.stop();
+  const LinesNodeTotals totals = lines.node.totals();
+  EXPECT_EQ(totals.receiver.sequence.received, sent.batches);
+  EXPECT_EQ(totals.receiver.sequence.lost, 0u);
+  EXPECT_EQ(totals.receiver.invalid_messages, 0u);
+  EXPECT_EQ(totals.events_stored, sent.events_published);
+  EXPECT_GT(totals.track_rounds, 0u);
+  EXPECT_EQ(collector.invalid(), 0);
+
+  const auto lists = collector.lists();
+  std::size_t most_segments = 0;
+  std::int64_t previous_seq = -1;
+  for (const auto& list : lists) {
+    EXPECT_EQ(list.seq, previous_seq + 1);
+    previous_seq = list.seq;
+    EXPECT_EQ(list.source, "cam0");
+    EXPECT_EQ(list.width, 240);
+    EXPECT_EQ(list.height, 180);
+    EXPECT_EQ(list.epoch, kEpoch);
+    most_segments = std::max(most_segments, list.segments.size());
+    std::vector<TrackedLine> decoded;
+    ASSERT_TRUE(read_segment_list(list, decoded));
+    for (const auto& line : decoded) {
+      EXPECT_GE(line.id, static_cast<std::uint64_t>(kEpoch));  // ids start at the process epoch
+      for (const Point2& q : {line.segment.q0, line.segment.q1}) {
+        EXPECT_TRUE(q.x() >= 0 && q.x() <= 240 && q.y() >= 0 && q.y() <= 180) << q.transpose();
+      }
+      EXPECT_GE(line.score, 0.0f);
+      EXPECT_LE(line.score, 1.0f);
+    }
+  }
+  EXPECT_GE(most_segments, 10u);  // boxes-6dof shows some 20 edges
+}
+
+TEST(Nodes, GarbageAndForeignMessagesAreCountedNotFatal) {
+  lcm::LCM lcm("memq://");
+  RunningLines lines(lcm, 1);
+  publish_raw(lcm, "EVENTS_CAM0", {'h', 'e', 'l', 'l', 'o'});
+  publish_raw(lcm, "EVENTS_CAM0", encode(segment_list_t{}));  // a real LCM type, but not ours to receive here
+  publish_raw(lcm, "EVENTS_CAM0", {});
+  EventBatch events;
+  events.push_back(10, 5, 5, 1);
+  events.push_back(20, 500, 5, 1);  // off the 240x180 sensor
+  event_batch_t batch;
+  fill_event_batch(events, batch);
+  batch.width = 240;
+  batch.height = 180;
+  batch.source = "test";
+  publish_raw(lcm, "EVENTS_CAM0", encode(batch));
+  batch.width = 320;  // a second sensor size on the same channel
+  batch.seq = 1;
+  publish_raw(lcm, "EVENTS_CAM0", encode(batch));
+  ASSERT_TRUE(wait_for([&] { return lines.node.totals().receiver.invalid_messages == 4; }));
+  lines.stop();
+  const LinesNodeTotals totals = lines.node.totals();
+  EXPECT_EQ(totals.events_stored, 1u);
+  EXPECT_EQ(totals.receiver.drops.off_sensor, 1u);
+  EXPECT_EQ(totals.receiver.sequence.received, 1u);
+}
+
+TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
+  lcm::LCM lcm("memq://");
+  ListCollector collector(lcm, "LINES_CAM0");
+  RunningLines lines(lcm, 1000);
+  const std::atomic<bool> never{false};
+  const auto source = scene_source("boxes-6dof", 200'000);
+  const CameraSummary first = CameraNode(lcm, fast_camera(), 1).run(source, never);
+  ASSERT_TRUE(wait_for([&] {
+    const auto lists = collector.lists();
+    return !lists.empty() && lists.back().newest_batch_seq == static_cast<std::int64_t>(first.batches - 1);
+  }));
+  const std::size_t lists_before = collector.lists().size();
+  // The camera process restarts: a newer epoch, sequence and event time from zero again.
+  const CameraSummary second = CameraNode(lcm, fast_camera(), 2).run(source, never);
+  ASSERT_TRUE(wait_for([&] {
+    const auto lists = collector.lists();
+    return lists.size() > lists_before && lists.back().newest_batch_seq == static_cast<std::int64_t>(second.batches - 1) &&
+           lists.back().t_us < 200'000 + 1000;
+  }));
+  lines.stop();
+  const LinesNodeTotals totals = lines.node.totals();
+  EXPECT_EQ(totals.engine_restarts, 1u);
+  EXPECT_EQ(totals.receiver.sequence.restarts, 1u);
+  EXPECT_EQ(totals.receiver.sequence.lost, 0u);
+  EXPECT_EQ(totals.receiver.drops.total(), 0u);  // the restarted clock is not "time backwards"
+  EXPECT_EQ(totals.events_stored, first.events_published + second.events_published);
+
+  // Ids of the first camera run and of the second never overlap.
+  const auto lists = collector.lists();
+  std::uint64_t max_before = 0, min_after = UINT64_MAX;
+  for (std::size_t i = 0; i < lists.size(); ++i) {
+    for (const auto& segment : lists[i].segments) {
+      const auto id = static_cast<std::uint64_t>(segment.id);
+      if (i < lists_before) max_before = std::max(max_before, id);
+      if (i >= lists_before && lists[i].t_us < lists[lists_before - 1].t_us) min_after = std::min(min_after, id);
+    }
+  }
+  ASSERT_GT(max_before, 0u);
+  ASSERT_LT(min_after, UINT64_MAX);
+  EXPECT_GT(min_after, max_before);
+}
+
+TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
+  lcm::LCM lcm("memq://");
+  VizNodeOptions options;
+  options.render_hz = 200;
+  options.render.scale = 2;
+  VizNode viz(lcm, options);
+
+  EventBatch events;  // a vertical run of events at x = 50
+  for (std::uint16_t y = 20; y < 120; ++y) events.push_back(1000 + y, 50, y, 1);
+  event_batch_t batch;
+  fill_event_batch(events, batch);
+  batch.width = 240;
+  batch.height = 180;
+  publish_raw(lcm, "EVENTS_CAM0", encode(batch));
+  TrackedLine line;
+  line.id = 9;
+  line.segment = {Point2(150.5f, 20.5f), Point2(150.5f, 160.5f)};
+  line.score = 0.9f;
+  line.status = LineStatus::GoodTrack;
+  segment_list_t list;
+  fill_segment_list(std::span<const TrackedLine>(&line, 1), list);
+  list.width = 240;
+  list.height = 180;
+  publish_raw(lcm, "LINES_CAM0", encode(list));
+  publish_raw(lcm, "LINES_CAM0", {1, 2, 3});  // refused, counted
+
+  cv::Mat last;
+  const std::atomic<bool> never{false};
+  viz.run(never, [&](const cv::Mat& frame) {
+    frame.copyTo(last);
+    return viz.totals().frames < 3;
+  });
+  EXPECT_EQ(viz.totals().frames, 3u);
+  EXPECT_EQ(viz.totals().segment_lists, 1u);
+  EXPECT_EQ(viz.totals().invalid_segment_lists, 1u);
+  ASSERT_EQ(last.cols, 480);
+  ASSERT_EQ(last.rows, 360);
+  // The event column is drawn grey and the good track green, at twice the scale.
+  const cv::Vec3b event_pixel = last.at<cv::Vec3b>(2 * 70, 2 * 50);
+  EXPECT_GT(event_pixel[0], 40);
+  int green = 0, red = 0;  // anti-aliased: look across the line's width
+  for (int x = 2 * 150 - 2; x <= 2 * 150 + 4; ++x) {
+    green = std::max<int>(green, last.at<cv::Vec3b>(2 * 90, x)[1]);
+    red = std::max<int>(red, last.at<cv::Vec3b>(2 * 90, x)[2]);
+  }
+  EXPECT_GT(green, 100);
+  EXPECT_LT(red, 60);
+}
+
+}  // namespace
+}  // namespace evldt

@@ -1,0 +1,130 @@
+#!/usr/bin/env bash
+# The distributed system end to end, real processes over UDP multicast on loopback (ttl=0):
+# camera -> lines -> viz + lcm-logger; the log replayed with lcm-logplayer into a second lines
+# service; junk on the event channel; SIGTERM stopping each service; lcm-spy's decoding of the log.
+# Usage: system_test.sh BUILD_DIR SOURCE_DIR
+set -uo pipefail
+build=$1
+source_dir=$2
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  for pid in "${pids[@]}"; do kill -9 "$pid" 2>/dev/null; done
+  rm -rf "$work"
+}
+trap cleanup EXIT
+failures=0
+check() {  # check DESCRIPTION COMMAND...
+  local what=$1
+  shift
+  if "$@"; then echo "ok: $what"; else echo "FAILED: $what"; failures=$((failures + 1)); fi
+}
+camera=$build/services/evldt-camera/evldt-camera
+lines=$build/services/evldt-lines/evldt-lines
+viz=$build/services/evldt-viz/evldt-viz
+offline=$build/tools/evldt-offline/evldt-offline
+eval_tool=$build/tools/evldt-eval/evldt-eval
+junk=$build/tests/lcm_publish_junk
+# Ports of this test only, so concurrent tests never hear each other.
+url="udpm://239.255.76.67:7711?ttl=0"
+replay_url="udpm://239.255.76.67:7712?ttl=0"
+scene=(--scene boxes-6dof --duration-s 1.5)
+
+# Sends SIGTERM (or $2) and checks the process is gone within a second.
+stops_within_a_second() {
+  local pid=$1 signal=${2:-TERM}
+  kill -s "$signal" "$pid"
+  for _ in $(seq 20); do
+    kill -0 "$pid" 2>/dev/null || { wait "$pid"; return 0; }
+    sleep 0.05
+  done
+  return 1
+}
+field() {  # field FILE REGEX: the first number after REGEX
+  grep -oP "$2\s*\K[0-9.]+" "$1" | head -1
+}
+f_at_1_percent() {  # the F of the first tolerance (1%) in an evldt-eval JSON
+  grep -oP '"f"\s*:\s*\K[0-9.]+' "$1" | head -1
+}
+close_to() {  # close_to A B TOLERANCE: both numbers present and |A - B| <= TOLERANCE
+  [[ -n $1 && -n $2 ]] && awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= tol) }'
+}
+
+# --- live run ---------------------------------------------------------------------------------
+lcm-logger --lcm-url="$url" -f -q "$work/live.lcm" &
+logger_pid=$!
+pids+=("$logger_pid")
+"$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines.out" 2>"$work/lines.err" &
+lines_pid=$!
+pids+=("$lines_pid")
+"$viz" --lcm-url "$url" --headless --video "$work/viz.mp4" --png-dir "$work/png" --png-period-s 0.5 --fps 20 \
+  >"$work/viz.out" 2>"$work/viz.err" &
+viz_pid=$!
+pids+=("$viz_pid")
+sleep 1
+"$junk" "$url" EVENTS_CAM0 8
+"$camera" --lcm-url "$url" "${scene[@]}" -q >"$work/camera.out" 2>"$work/camera.err"
+check "camera exits 0" test $? -eq 0
+sleep 0.5
+check "evldt-lines stops within 1 s of SIGTERM" stops_within_a_second "$lines_pid"
+check "evldt-viz stops within 1 s of SIGTERM" stops_within_a_second "$viz_pid"
+stops_within_a_second "$logger_pid" INT
+cat "$work/camera.out" "$work/lines.out" "$work/viz.out"
+
+batches=$(field "$work/camera.out" 'batches')
+check "lines received every batch ($batches)" grep -q "batches   $batches received, 0 lost" "$work/lines.out"
+check "junk counted as 8 invalid messages" grep -q " 8 invalid messages" "$work/lines.out"
+check "lines stored events" test "$(field "$work/lines.out" 'events')" -gt 100000
+check "viz drew frames into the mp4" test -s "$work/viz.mp4"
+check "viz wrote PNG snapshots" test "$(ls "$work/png" | wc -l)" -ge 2
+check "viz received the segment lists" grep -qP "received  $batches batches \(0 lost, 8 invalid\), [1-9][0-9]* segment lists \(0 invalid\), [1-9]" "$work/viz.out"
+
+# The recorded events are exactly the simulated ones: offline on the log = offline on the scene.
+"$offline" "$work/live.lcm" -o "$work/from_log.csv" -q >/dev/null 2>&1
+"$offline" "${scene[@]}" -o "$work/direct.csv" -q >/dev/null 2>&1
+check "offline run on the lcm-log is byte-identical to the direct run" cmp -s "$work/from_log.csv" "$work/direct.csv"
+
+# The live segments are as accurate as the offline runner's on the same events.
+"$eval_tool" --segments "$work/live.lcm" "${scene[@]}" --json "$work/live.json" >/dev/null 2>&1
+"$eval_tool" --segments "$work/direct.csv" "${scene[@]}" --json "$work/direct.json" >/dev/null 2>&1
+live_f=$(f_at_1_percent "$work/live.json")
+offline_f=$(f_at_1_percent "$work/direct.json")
+echo "F@1%: live $live_f, offline $offline_f"
+check "live F@1% within 0.06 of offline" close_to "$live_f" "$offline_f" 0.06
+check "live F@1% >= 0.75" close_to "$live_f" 0.875 0.125
+
+# --- replay: lcm-logplayer feeds the recorded events to a fresh lines service ------------------
+lcm-logger --lcm-url="$replay_url" -f -q --channel='LINES_.*' "$work/replay.lcm" &
+replay_logger_pid=$!
+pids+=("$replay_logger_pid")
+"$lines" --lcm-url "$replay_url" --log-period-s 0 >"$work/replay_lines.out" 2>"$work/replay_lines.err" &
+replay_lines_pid=$!
+pids+=("$replay_lines_pid")
+sleep 1
+lcm-logplayer --lcm-url="$replay_url" --regexp='EVENTS_.*' "$work/live.lcm"
+sleep 0.5
+stops_within_a_second "$replay_lines_pid"
+stops_within_a_second "$replay_logger_pid" INT
+cat "$work/replay_lines.out"
+check "replayed lines received every batch" grep -q "batches   $batches received, 0 lost" "$work/replay_lines.out"
+"$eval_tool" --segments "$work/replay.lcm" "${scene[@]}" --json "$work/replay.json" >/dev/null 2>&1
+replay_f=$(f_at_1_percent "$work/replay.json")
+echo "F@1%: replayed $replay_f"
+check "replayed F@1% within 0.06 of the live run" close_to "$replay_f" "$live_f" 0.06
+
+# --- lcm-spy decodes every message type -----------------------------------------------------
+jar=$build/lcmtypes/evldt_lcmtypes.jar
+if [[ -f $jar ]] && command -v javac >/dev/null; then
+  javac -d "$work/java" -cp /usr/share/java/lcm.jar "$source_dir/tests/services/LcmSpyDecodeCheck.java"
+  java -cp "/usr/share/java/lcm.jar:/usr/share/java/jchart2d.jar:$jar:$work/java" LcmSpyDecodeCheck "$work/live.lcm" | tee "$work/spy.out"
+  check "lcm-spy's type lookup decodes the event, segment and stats messages" \
+    grep -q "EVENTS_CAM0 evldt.event_batch_t" "$work/spy.out"
+  check "... segment lists" grep -q "LINES_CAM0 evldt.segment_list_t" "$work/spy.out"
+  check "... statistics" grep -q "EVLDT_STATS evldt.stats_t" "$work/spy.out"
+  check "... and the junk does not decode" grep -qP "EVENTS_CAM0 (undecodable|no-type) [1-8]$" "$work/spy.out"
+else
+  echo "skipped: lcm-spy decoding (no javac or no jar)"
+fi
+
+echo "$failures failure(s)"
+exit $((failures > 0))
