@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     const auto& stop = stop_on_signals();
     const auto lcm = lcm_options.connect();
     LinesNode node(*lcm, options, process_epoch_us());
-    spdlog::info("listening on {} ({}), publishing {} at {} Hz", events_channel(options.camera), lcm_options.url(),
+    spdlog::info("listening on {} ({}), publishing {} at {} Hz", events_channel(options.camera), lcm_options.effective_url(),
                  lines_channel(options.camera), options.publish_hz);
     node.run(stop);
     const LinesNodeTotals t = node.totals();
@@ -48,14 +48,15 @@ int main(int argc, char** argv) {
         "  batches   %llu received, %llu lost (sequence gaps), %llu late, %llu invalid messages, %llu camera restarts\n"
         "  events    %llu stored, %llu dropped (%llu off sensor, %llu back in time)\n"
         "  loops     %llu detection rounds, %llu tracking rounds\n"
-        "  output    %llu lines created, %llu segment lists published\n",
+        "  output    %llu lines created, %llu segment lists published\n"
+        "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches)\n",
         static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),
         static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.invalid_messages),
         static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.events_stored),
         static_cast<unsigned long long>(t.receiver.drops.total()), static_cast<unsigned long long>(t.receiver.drops.off_sensor),
         static_cast<unsigned long long>(t.receiver.drops.time_backwards), static_cast<unsigned long long>(t.detect_rounds),
         static_cast<unsigned long long>(t.track_rounds), static_cast<unsigned long long>(t.lines_created),
-        static_cast<unsigned long long>(t.lists_published));
+        static_cast<unsigned long long>(t.lists_published), t.latency.median_ms, t.latency.p99_ms, t.latency.samples);
     return 0;
   });
 }

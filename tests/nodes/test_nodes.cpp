@@ -114,6 +114,7 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
   ASSERT_TRUE(lcm.good());
   ListCollector collector(lcm, "LINES_CAM0");
   constexpr std::int64_t kEpoch = 5'000'000;
+  const int kBlock = default_config_for(SensorSize{240, 180}).lattice.block_size;
   RunningLines lines(lcm, kEpoch);
   CameraNode camera(lcm, fast_camera(), 77);
   const std::atomic<bool> never{false};
@@ -155,8 +156,12 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
       for (const Point2& q : {line.segment.q0, line.segment.q1}) {
         EXPECT_TRUE(q.x() >= 0 && q.x() <= 240 && q.y() >= 0 && q.y() <= 180) << q.transpose();
       }
+      // f = r_o * r_e with r_o <= 1 and r_e <= (blocks the line crosses), as r_e is normalised by
+      // one block's capacity (EffectiveRatioNorm::Block); a segment of length L crosses at most
+      // sqrt(2) L / b + 2 blocks.
+      const float max_blocks = std::sqrt(2.0f) * line.segment.length() / static_cast<float>(kBlock) + 2.0f;
       EXPECT_GE(line.score, 0.0f);
-      EXPECT_LE(line.score, 1.0f);
+      EXPECT_LE(line.score, max_blocks) << line.segment.length();
     }
   }
   EXPECT_GE(most_segments, 10u);  // boxes-6dof shows some 20 edges

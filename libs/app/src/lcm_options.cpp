@@ -29,8 +29,15 @@ void LcmOptions::add_to(CLI::App& app) {
       });
 }
 
+std::string LcmOptions::effective_url() const {
+  // A large socket buffer rides out scheduling hiccups at kHz batch rates; the kernel caps it at
+  // net.core.rmem_max (see deploy/README.md).
+  if (!url_.starts_with("udpm://") || url_.find("recv_buf_size") != std::string::npos) return url_;
+  return url_ + (url_.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=" + std::to_string(kReceiveBufferBytes);
+}
+
 std::unique_ptr<lcm::LCM> LcmOptions::connect() const {
-  auto lcm = std::make_unique<lcm::LCM>(url_);
+  auto lcm = std::make_unique<lcm::LCM>(effective_url());
   if (!lcm->good()) {
     throw std::runtime_error("cannot start LCM on " + url_ +
                              " (a multicast URL needs a multicast route: on one host, "

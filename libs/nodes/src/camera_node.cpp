@@ -60,7 +60,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   EventBatcher batcher(options_.batch_us, options_.max_batch);
   Pacer pacer(options_.speed);
   EventBatch chunk, batch;
-  std::optional<Timestamp> first_t;
+  first_published_t_.reset();
   Timestamp offset = 0;         // added to event times so every loop continues forward in time
   bool rebase = false;
   const auto started = Clock::now();
@@ -94,7 +94,6 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
       }
       validator.filter(chunk);
       if (chunk.empty()) continue;
-      if (!first_t) first_t = chunk.t.front();
       batcher.push(chunk);
       publish_ready(false);
       if (options_.progress_period_s > 0 &&
@@ -102,7 +101,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
         last_progress = Clock::now();
         spdlog::info("{:.0f}% of {}: {} events in {} batches, {:.2f} s of event time", 100.0 * source->progress(),
                      source->name(), summary.events_published, summary.batches,
-                     static_cast<double>(validator.newest_time() - first_t.value_or(0)) * 1e-6);
+                     summary.event_seconds);
       }
     }
   } catch (const FormatError& error) {
@@ -111,7 +110,6 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   }
   publish_ready(true);
   summary.drops = validator.drops();
-  summary.event_seconds = first_t ? static_cast<double>(validator.newest_time() - *first_t) * 1e-6 : 0.0;
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();
   return summary;
 }
@@ -129,6 +127,8 @@ void CameraNode::publish(const EventBatch& batch, CameraSummary& summary) {
     // The sequence number still advances: subscribers count the batch as lost.
     if (std::has_single_bit(++summary.publish_failures)) spdlog::warn("{} batch publish(es) failed", summary.publish_failures);
   } else {
+    if (!first_published_t_) first_published_t_ = batch.t.front();
+    summary.event_seconds = static_cast<double>(batch.t.back() - *first_published_t_) * 1e-6;
     summary.events_published += batch.size();
     summary.bytes += static_cast<std::uint64_t>(msg.getEncodedSize());
   }

@@ -31,6 +31,9 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
   subscription_ = lcm_.subscribe(events_channel(options_.camera), &LinesNode::on_events, this);
   if (!subscription_) throw std::runtime_error("cannot subscribe to " + events_channel(options_.camera));
+  // LCM queues 30 messages per subscription by default and drops beyond; a stall of a few ms at
+  // kHz batch rates would lose batches.
+  subscription_->setQueueCapacity(kEventQueueCapacity);
 }
 
 LinesNode::~LinesNode() {
@@ -189,6 +192,7 @@ LinesNodeTotals LinesNode::totals() const {
     totals.detect_rounds = retired_.detect_rounds;
     totals.track_rounds = retired_.track_rounds;
     totals.lines_created = retired_.lines_created;
+    totals.latency = latency_.run_summary();
   }
   if (engine) {
     const EngineCounters counters = engine->counters();

@@ -30,6 +30,8 @@ VizNode::VizNode(lcm::LCM& lcm, VizNodeOptions options)
   if (!(options_.render_hz > 0 && options_.render_hz <= 1000)) throw std::invalid_argument("render rate must be in (0, 1000] Hz");
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
   subscriptions_.push_back(lcm_.subscribe(events_channel(options_.camera), &VizNode::on_events, this));
+  // Drawing and encoding a frame takes milliseconds: queue the batches meanwhile (LCM's default is 30).
+  subscriptions_.back()->setQueueCapacity(kEventQueueCapacity);
   subscriptions_.push_back(lcm_.subscribe(lines_channel(options_.camera), &VizNode::on_lines, this));
   subscriptions_.push_back(lcm_.subscribe(std::string(kStatsChannel), &VizNode::on_stats, this));
 }

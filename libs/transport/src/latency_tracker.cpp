@@ -6,7 +6,9 @@
 namespace evldt {
 
 LatencyTracker::LatencyTracker(std::size_t pending_capacity, std::size_t sample_capacity)
-    : ring_(std::max<std::size_t>(pending_capacity, 1)), sample_capacity_(sample_capacity) {
+    : ring_(std::max<std::size_t>(pending_capacity, 1)),
+      sample_capacity_(sample_capacity),
+      run_histogram_(static_cast<std::size_t>(1000.0 / kBinMs) + 1) {
   samples_ms_.reserve(sample_capacity);
 }
 
@@ -23,9 +25,11 @@ LatencyTracker::Included LatencyTracker::list_published(Timestamp lattice_us, st
   // Batches arrive in event-time order, so the included ones are a prefix of the ring.
   while (count_ > 0 && ring_[head_].newest_event_us <= lattice_us) {
     const Pending& batch = ring_[head_];
-    if (samples_ms_.size() < sample_capacity_) {
-      samples_ms_.push_back(static_cast<double>(now_utime - batch.utime) * 1e-3);
-    }
+    const double latency_ms = static_cast<double>(now_utime - batch.utime) * 1e-3;
+    if (samples_ms_.size() < sample_capacity_) samples_ms_.push_back(latency_ms);
+    const double bin = std::clamp(latency_ms / kBinMs, 0.0, static_cast<double>(run_histogram_.size() - 1));
+    ++run_histogram_[static_cast<std::size_t>(bin)];
+    ++run_samples_;
     newest_ = {batch.seq, batch.utime};
     head_ = (head_ + 1) % ring_.size();
     --count_;
@@ -46,6 +50,25 @@ LatencySummary LatencyTracker::take_summary() {
     summary.p99_ms = quantile(0.99);
   }
   samples_ms_.clear();
+  return summary;
+}
+
+LatencySummary LatencyTracker::run_summary() const {
+  LatencySummary summary;
+  summary.samples = static_cast<std::uint32_t>(std::min<std::uint64_t>(run_samples_, UINT32_MAX));
+  if (run_samples_ == 0) return summary;
+  // The upper edge of the bin holding the q-quantile sample.
+  const auto quantile = [&](double q) {
+    const auto rank = static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(run_samples_)));
+    std::uint64_t seen = 0;
+    for (std::size_t bin = 0; bin < run_histogram_.size(); ++bin) {
+      seen += run_histogram_[bin];
+      if (seen >= rank) return static_cast<double>(bin + 1) * kBinMs;
+    }
+    return static_cast<double>(run_histogram_.size()) * kBinMs;
+  };
+  summary.median_ms = quantile(0.5);
+  summary.p99_ms = quantile(0.99);
   return summary;
 }
 

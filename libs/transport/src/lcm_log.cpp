@@ -93,6 +93,7 @@ std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std:
   std::vector<TrackedLine> lines;
   std::size_t step_begin = 0;
   Timestamp step_t = INT64_MIN;
+  bool any_list = false;
   while (const lcm::LogEvent* event = log->readNextEvent()) {
     if (!channel_matches(channel, "LINES_", event->channel)) continue;
     if (decode_message(payload(*event), msg) != WireError::None || !read_segment_list(msg, lines)) {
@@ -100,10 +101,11 @@ std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std:
       continue;
     }
     if (channel.empty()) channel = event->channel;
+    any_list = true;
     // Lists are published at a fixed rate: one of the same lattice time as the previous replaces it.
     if (msg.t_us == step_t) {
       rows.resize(step_begin);
-    } else if (!rows.empty() && msg.t_us < step_t) {
+    } else if (msg.t_us < step_t) {
       ++invalid;  // back in time (a restarted lines service): steps must stay ordered
       continue;
     }
@@ -116,7 +118,10 @@ std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std:
   }
   report_unread_tail(*log, path);
   if (invalid) spdlog::warn("{}: {} invalid segment lists skipped", path.string(), invalid);
-  if (channel.empty()) throw std::runtime_error("no valid segment list on a LINES_* channel in LCM log " + path.string());
+  if (!any_list) {
+    throw std::runtime_error("no valid segment list on " + (channel.empty() ? std::string("a LINES_* channel") : channel) +
+                             " in LCM log " + path.string());
+  }
   return rows;
 }
 

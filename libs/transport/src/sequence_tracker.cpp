@@ -3,19 +3,19 @@
 namespace evldt {
 
 bool SequenceTracker::observe(std::int64_t epoch, std::int64_t seq) {
-  if (started_ && (epoch < epoch_ || (epoch == epoch_ && seq < expected_))) {
+  if (started_ && (epoch < epoch_ || (epoch == epoch_ && seq <= last_))) {
     ++counts_.late;
     return false;
   }
   if (started_ && epoch == epoch_) {
     // Unsigned difference: a forged sequence number cannot overflow the count.
-    counts_.lost += static_cast<std::uint64_t>(seq) - static_cast<std::uint64_t>(expected_);
+    counts_.lost += static_cast<std::uint64_t>(seq) - static_cast<std::uint64_t>(last_) - 1;
   } else if (started_) {
     ++counts_.restarts;
   }
   started_ = true;
   epoch_ = epoch;
-  expected_ = seq + (seq < INT64_MAX ? 1 : 0);
+  last_ = seq;
   ++counts_.received;
   return true;
 }

@@ -15,6 +15,9 @@ class LcmOptions {
   /// Adds --lcm-url (default: $LCM_DEFAULT_URL, else multicast on this host with ttl=0) and --camera.
   void add_to(CLI::App& app);
   [[nodiscard]] const std::string& url() const { return url_; }
+  /// The URL connected to: a udpm URL without recv_buf_size gets kReceiveBufferBytes.
+  [[nodiscard]] std::string effective_url() const;
+  static constexpr int kReceiveBufferBytes = 8 << 20;
   [[nodiscard]] const std::string& camera() const { return camera_; }
   /// Connects; throws std::runtime_error with the likely cause (multicast route) if LCM cannot start.
   [[nodiscard]] std::unique_ptr<lcm::LCM> connect() const;

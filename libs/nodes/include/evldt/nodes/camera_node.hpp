@@ -37,7 +37,7 @@ struct CameraSummary {
   std::uint64_t publish_failures = 0;
   std::uint64_t bytes = 0;           ///< encoded message bytes published
   std::uint64_t loops = 0;           ///< times the source was restarted by --loop
-  double event_seconds = 0;          ///< event time published
+  double event_seconds = 0;          ///< event time spanned by the published batches
   double wall_seconds = 0;
   double max_lag_s = 0;              ///< furthest behind the pace
   std::string input_error;           ///< set if the source ended in a format error
@@ -63,6 +63,7 @@ class CameraNode {
   std::int64_t epoch_us_;
   std::string channel_;
   event_batch_t msg_;
+  std::optional<Timestamp> first_published_t_;
 };
 
 }  // namespace evldt

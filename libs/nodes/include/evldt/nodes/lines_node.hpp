@@ -37,6 +37,7 @@ struct LinesNodeTotals {
   std::uint64_t lines_created = 0;
   std::uint64_t lists_published = 0;
   std::uint64_t engine_restarts = 0;  ///< the camera restarted (new epoch): the lattice began afresh
+  LatencySummary latency;             ///< batch publish -> first list including it, since the last camera (re)start
 };
 
 class LinesNode {

@@ -11,6 +11,10 @@ inline constexpr std::string_view kStatsChannel = "EVLDT_STATS";
 /// The default URL: multicast on this host only (ttl=0); ttl=1 reaches the robot's LAN.
 inline constexpr std::string_view kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
 
+/// Event batches a subscriber lets LCM queue for it (about 4 s at the default 1 kHz batch rate;
+/// LCM's own default of 30 loses batches whenever the handler stalls for a few milliseconds).
+inline constexpr int kEventQueueCapacity = 4096;
+
 /// "front" -> "EVENTS_FRONT".
 std::string events_channel(std::string_view camera);
 /// "front" -> "LINES_FRONT".

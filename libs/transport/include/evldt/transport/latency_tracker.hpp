@@ -35,6 +35,8 @@ class LatencyTracker {
 
   /// Median and p99 of the latencies recorded since the previous call.
   LatencySummary take_summary();
+  /// Median and p99 since construction, to 0.1 ms (a histogram; latencies above 1 s count as 1 s).
+  [[nodiscard]] LatencySummary run_summary() const;
 
  private:
   struct Pending {
@@ -46,6 +48,9 @@ class LatencyTracker {
   std::size_t head_ = 0, count_ = 0;
   std::vector<double> samples_ms_;
   std::size_t sample_capacity_;
+  static constexpr double kBinMs = 0.1;
+  std::vector<std::uint64_t> run_histogram_;  ///< bins of kBinMs up to 1 s
+  std::uint64_t run_samples_ = 0;
   Included newest_;
 };
 

@@ -23,7 +23,7 @@ class SequenceTracker {
  private:
   bool started_ = false;
   std::int64_t epoch_ = 0;
-  std::int64_t expected_ = 0;
+  std::int64_t last_ = 0;  ///< newest sequence number accepted in this epoch
   SequenceCounts counts_;
 };
 

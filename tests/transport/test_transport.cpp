@@ -1,0 +1,486 @@
+// The transport layer on its own: checked decoding of every message type, event batching, loss and
+// latency accounting, the receiving end of an event channel, pacing and reading lcm-logger files.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+
+#include "evldt/transport/channels.hpp"
+#include "evldt/transport/event_batch_receiver.hpp"
+#include "evldt/transport/event_batcher.hpp"
+#include "evldt/transport/latency_tracker.hpp"
+#include "evldt/transport/lcm_log.hpp"
+#include "evldt/transport/messages.hpp"
+#include "evldt/transport/pacer.hpp"
+#include "evldt/transport/sequence_tracker.hpp"
+
+namespace evldt {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+template <typename Message>
+Bytes encode(const Message& msg) {
+  Bytes bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  EXPECT_EQ(msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+EventBatch make_events(std::size_t n, Timestamp t0 = 1000, Timestamp step = 3) {
+  EventBatch events;
+  for (std::size_t i = 0; i < n; ++i) {
+    events.push_back(t0 + static_cast<Timestamp>(i) * step, static_cast<std::uint16_t>(i % 240),
+                     static_cast<std::uint16_t>(i % 180), i % 3 ? std::int8_t{1} : std::int8_t{-1});
+  }
+  return events;
+}
+
+event_batch_t make_batch(const EventBatch& events, std::int64_t seq, std::int64_t epoch = 7, int width = 240,
+                         int height = 180) {
+  event_batch_t msg;
+  msg.utime = 123;
+  msg.epoch = epoch;
+  msg.seq = seq;
+  msg.source = "cam0";
+  msg.width = static_cast<std::int16_t>(width);
+  msg.height = static_cast<std::int16_t>(height);
+  fill_event_batch(events, msg);
+  return msg;
+}
+
+segment_list_t make_list() {
+  TrackedLine a;
+  a.id = 42;
+  a.segment = Segment{Point2(1.5, 2.5), Point2(30.25, 40.75)};
+  a.score = 0.8F;
+  a.status = LineStatus::GoodTrack;
+  a.admin_block = 17;
+  a.first_seen_us = 100;
+  a.last_good_us = 900;
+  TrackedLine b = a;
+  b.id = 43;
+  b.status = LineStatus::BadTrack;
+  segment_list_t msg;
+  msg.utime = 5;
+  msg.epoch = 6;
+  msg.seq = 7;
+  msg.source = "cam0";
+  msg.width = 240;
+  msg.height = 180;
+  msg.t_us = 1000;
+  msg.newest_batch_seq = 3;
+  msg.newest_batch_utime = 4;
+  const std::vector<TrackedLine> lines{a, b};
+  fill_segment_list(lines, msg);
+  return msg;
+}
+
+stats_t make_stats() {
+  stats_t msg{};
+  msg.service = "evldt-lines";
+  msg.source = "cam0";
+  msg.events_in = 99;
+  return msg;
+}
+
+// ---- checked decoding ----------------------------------------------------------------------------
+
+TEST(Messages, EventBatchRoundTripKeepsEveryEvent) {
+  const EventBatch events = make_events(500);
+  const Bytes bytes = encode(make_batch(events, 3));
+  EXPECT_EQ(bytes.size(), 8 + 3 * 8 + 4 + 5 + 2 * 2 + 8 + 4 + 500 * kEventWireBytes);
+  event_batch_t decoded;
+  ASSERT_EQ(decode_message(bytes, decoded), WireError::None);
+  EXPECT_EQ(decoded.seq, 3);
+  EXPECT_EQ(decoded.source, "cam0");
+  EventBatch back;
+  ASSERT_TRUE(read_event_batch(decoded, back));
+  ASSERT_EQ(back.size(), events.size());
+  for (std::size_t i = 0; i < events.size(); ++i) EXPECT_EQ(back[i], events[i]) << i;
+}
+
+TEST(Messages, SegmentListRoundTripKeepsEveryField) {
+  const segment_list_t msg = make_list();
+  segment_list_t decoded;
+  ASSERT_EQ(decode_message(encode(msg), decoded), WireError::None);
+  std::vector<TrackedLine> lines;
+  ASSERT_TRUE(read_segment_list(decoded, lines));
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0].id, 42u);
+  EXPECT_FLOAT_EQ(lines[0].segment.q1.x(), 30.25F);
+  EXPECT_FLOAT_EQ(lines[0].segment.q1.y(), 40.75F);
+  EXPECT_EQ(lines[0].status, LineStatus::GoodTrack);
+  EXPECT_EQ(lines[1].status, LineStatus::BadTrack);
+  EXPECT_EQ(lines[0].admin_block, 17);
+  EXPECT_EQ(lines[0].last_good_us, 900);
+}
+
+TEST(Messages, StatsRoundTrip) {
+  stats_t decoded;
+  ASSERT_EQ(decode_message(encode(make_stats()), decoded), WireError::None);
+  EXPECT_EQ(decoded.events_in, 99);
+  EXPECT_EQ(decoded.service, "evldt-lines");
+}
+
+// Every strict prefix of a valid message, and the message with a byte appended, must be refused.
+template <typename Message>
+void expect_every_prefix_malformed(const Bytes& bytes) {
+  Message out;
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    const WireError error = decode_message(std::span(bytes.data(), n), out);
+    ASSERT_EQ(error, WireError::Malformed) << "prefix of " << n << " of " << bytes.size() << " bytes";
+  }
+  Bytes longer = bytes;
+  longer.push_back(0);
+  EXPECT_EQ(decode_message(longer, out), WireError::Malformed);
+}
+
+TEST(Messages, EveryTruncationIsMalformed) {
+  expect_every_prefix_malformed<event_batch_t>(encode(make_batch(make_events(20), 1)));
+  expect_every_prefix_malformed<segment_list_t>(encode(make_list()));
+  expect_every_prefix_malformed<stats_t>(encode(make_stats()));
+}
+
+TEST(Messages, AnotherTypeIsWrongTypeNotMalformed) {
+  event_batch_t batch;
+  segment_list_t list;
+  stats_t stats;
+  EXPECT_EQ(decode_message(encode(make_list()), batch), WireError::WrongType);
+  EXPECT_EQ(decode_message(encode(make_batch(make_events(3), 0)), list), WireError::WrongType);
+  EXPECT_EQ(decode_message(encode(make_list()), stats), WireError::WrongType);
+}
+
+// Offset of num_events in an encoded event batch with the source "cam0".
+constexpr std::size_t kNumEventsOffset = 8 + 3 * 8 + 4 + 5 + 2 * 2 + 8;
+
+TEST(Messages, ForgedCountIsRefusedBeforeAllocating) {
+  Bytes bytes = encode(make_batch(make_events(4), 0));
+  // Claim 2^31-1 events in a message carrying four: lcm-gen's decoder would size the arrays first.
+  bytes[kNumEventsOffset] = 0x7F;
+  bytes[kNumEventsOffset + 1] = bytes[kNumEventsOffset + 2] = bytes[kNumEventsOffset + 3] = 0xFF;
+  event_batch_t out;
+  EXPECT_EQ(decode_message(bytes, out), WireError::Malformed);
+  bytes[kNumEventsOffset] = 0x80;  // negative
+  EXPECT_EQ(decode_message(bytes, out), WireError::Malformed);
+}
+
+TEST(Messages, UnterminatedOrOverlongStringIsMalformed) {
+  Bytes bytes = encode(make_batch(make_events(2), 0));
+  const std::size_t string_end = 8 + 3 * 8 + 4 + 4;  // the NUL after "cam0"
+  bytes[string_end] = 'x';
+  event_batch_t out;
+  EXPECT_EQ(decode_message(bytes, out), WireError::Malformed);
+  Bytes overlong = encode(make_batch(make_events(2), 0));
+  overlong[8 + 3 * 8] = 0x7F;  // string length far beyond the message
+  EXPECT_EQ(decode_message(overlong, out), WireError::Malformed);
+}
+
+TEST(Messages, SegmentListWithUnknownStatusOrNanIsRefused) {
+  segment_list_t msg = make_list();
+  std::vector<TrackedLine> lines;
+  msg.segments[1].status = 3;
+  EXPECT_FALSE(read_segment_list(msg, lines));
+  EXPECT_TRUE(lines.empty());
+  msg = make_list();
+  msg.segments[0].x1 = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(read_segment_list(msg, lines));
+}
+
+TEST(Messages, NegativeCoordinatesBecomeOffSensorAndBadTimeBaseIsRefused) {
+  event_batch_t msg = make_batch(make_events(2), 0);
+  msg.x[0] = -5;
+  EventBatch out;
+  ASSERT_TRUE(read_event_batch(msg, out));
+  EXPECT_FALSE((SensorSize{240, 180}.contains(out.x[0], out.y[0])));
+  msg.t_base_us = -1;
+  out.clear();
+  EXPECT_FALSE(read_event_batch(msg, out));
+  EXPECT_TRUE(out.empty());
+}
+
+TEST(Messages, BatchSpanBeyondInt32IsRejectedOnFill) {
+  EventBatch events;
+  events.push_back(0, 1, 1, 1);
+  events.push_back(kMaxBatchSpanUs + 1, 1, 1, 1);
+  event_batch_t msg;
+  EXPECT_THROW(fill_event_batch(events, msg), std::invalid_argument);
+}
+
+// ---- channels -----------------------------------------------------------------------------------
+
+TEST(Channels, NamesAreUpperCaseAndCameraNamesChecked) {
+  EXPECT_EQ(events_channel("front_1"), "EVENTS_FRONT_1");
+  EXPECT_EQ(lines_channel("cam0"), "LINES_CAM0");
+  EXPECT_NO_THROW(check_camera_name("cam_0"));
+  EXPECT_THROW(check_camera_name(""), std::invalid_argument);
+  EXPECT_THROW(check_camera_name("a.b"), std::invalid_argument);
+  EXPECT_THROW(check_camera_name(std::string(33, 'a')), std::invalid_argument);
+}
+
+// ---- batching -----------------------------------------------------------------------------------
+
+TEST(EventBatcher, CutsAtAlignedWindowsAndMaxSize) {
+  EventBatcher batcher(1000, 4);
+  EventBatch in;
+  for (Timestamp t : {10, 20, 30, 990, 1000, 1500, 2999, 3000}) in.push_back(t, 1, 1, 1);
+  in.push_back(3001, 1, 1, 1);
+  batcher.push(in);
+  EventBatch out;
+  std::vector<std::vector<Timestamp>> batches;
+  while (batcher.pop(out)) batches.push_back(out.t);
+  // [10,20,30,990] fills max_events; [1000,1500] ends at the window; [2999]; [3000,3001] incomplete.
+  const std::vector<std::vector<Timestamp>> expected{{10, 20, 30, 990}, {1000, 1500}, {2999}};
+  EXPECT_EQ(batches, expected);
+  EXPECT_EQ(batcher.pending(), 2u);
+  ASSERT_TRUE(batcher.pop(out, /*flush=*/true));
+  EXPECT_EQ(out.t, (std::vector<Timestamp>{3000, 3001}));
+  EXPECT_FALSE(batcher.pop(out, true));
+}
+
+TEST(EventBatcher, KeepsEveryEventInOrderAcrossManyPushes) {
+  EventBatcher batcher(250, 100);
+  std::vector<Timestamp> popped;
+  EventBatch out;
+  for (int chunk = 0; chunk < 50; ++chunk) {
+    batcher.push(make_events(37, 1000 + chunk * 37 * 5, 5));
+    while (batcher.pop(out)) {
+      ASSERT_LE(out.size(), 100u);
+      popped.insert(popped.end(), out.t.begin(), out.t.end());
+    }
+  }
+  while (batcher.pop(out, true)) popped.insert(popped.end(), out.t.begin(), out.t.end());
+  ASSERT_EQ(popped.size(), 50u * 37u);
+  for (std::size_t i = 0; i < popped.size(); ++i) ASSERT_EQ(popped[i], 1000 + static_cast<Timestamp>(i) * 5);
+}
+
+TEST(EventBatcher, RefusesZeroWindowOrSize) {
+  EXPECT_THROW(EventBatcher(0, 10), std::invalid_argument);
+  EXPECT_THROW(EventBatcher(10, 0), std::invalid_argument);
+}
+
+// ---- sequence and latency accounting -----------------------------------------------------------
+
+TEST(SequenceTracker, CountsGapsLateAndRestarts) {
+  SequenceTracker tracker;
+  EXPECT_TRUE(tracker.observe(1, 0));
+  EXPECT_TRUE(tracker.observe(1, 1));
+  EXPECT_TRUE(tracker.observe(1, 5));   // 2, 3, 4 lost
+  EXPECT_FALSE(tracker.observe(1, 5));  // duplicate
+  EXPECT_FALSE(tracker.observe(1, 3));  // reordered
+  EXPECT_TRUE(tracker.observe(2, 0));   // restarted publisher
+  EXPECT_FALSE(tracker.observe(1, 6));  // the old epoch
+  EXPECT_TRUE(tracker.observe(2, 1));
+  const SequenceCounts& counts = tracker.counts();
+  EXPECT_EQ(counts.received, 5u);
+  EXPECT_EQ(counts.lost, 3u);
+  EXPECT_EQ(counts.late, 3u);
+  EXPECT_EQ(counts.restarts, 1u);
+}
+
+TEST(SequenceTracker, ForgedHugeSequenceDoesNotOverflow) {
+  SequenceTracker tracker;
+  EXPECT_TRUE(tracker.observe(1, INT64_MIN));
+  EXPECT_TRUE(tracker.observe(1, INT64_MAX));
+  EXPECT_FALSE(tracker.observe(1, INT64_MAX));
+  EXPECT_EQ(tracker.counts().lost, UINT64_MAX - 1);
+}
+
+TEST(LatencyTracker, MeasuresFromPublishToTheListThatIncludesTheBatch) {
+  LatencyTracker tracker(4, 100);
+  tracker.batch_stored(0, 1000, 100);
+  tracker.batch_stored(1, 2000, 200);
+  tracker.batch_stored(2, 3000, 300);
+  auto included = tracker.list_published(150, 5000);  // only batch 0: 4 ms
+  EXPECT_EQ(included.seq, 0);
+  EXPECT_EQ(included.utime, 1000);
+  included = tracker.list_published(150, 6000);  // nothing new
+  EXPECT_EQ(included.seq, 0);
+  included = tracker.list_published(300, 7000);  // batches 1 and 2: 5 ms and 4 ms
+  EXPECT_EQ(included.seq, 2);
+  const LatencySummary period = tracker.take_summary();
+  EXPECT_EQ(period.samples, 3u);
+  EXPECT_DOUBLE_EQ(period.median_ms, 4.0);
+  EXPECT_DOUBLE_EQ(period.p99_ms, 5.0);
+  EXPECT_EQ(tracker.take_summary().samples, 0u);
+  const LatencySummary run = tracker.run_summary();  // bins of 0.1 ms, upper edges
+  EXPECT_EQ(run.samples, 3u);
+  EXPECT_NEAR(run.median_ms, 4.1, 1e-9);
+  EXPECT_NEAR(run.p99_ms, 5.1, 1e-9);
+}
+
+TEST(LatencyTracker, ForgetsTheOldestBeyondCapacity) {
+  LatencyTracker tracker(2, 100);
+  for (std::int64_t seq = 0; seq < 5; ++seq) tracker.batch_stored(seq, seq * 1000, seq * 10);
+  tracker.list_published(1000, 10000);
+  EXPECT_EQ(tracker.take_summary().samples, 2u);  // batches 3 and 4 only
+}
+
+// ---- receiving end -----------------------------------------------------------------------------
+
+TEST(EventBatchReceiver, AdoptsSensorCountsLossAndRefusesForeignPayloads) {
+  EventBatchReceiver receiver(std::nullopt, 0);
+  EventBatch out;
+  ASSERT_TRUE(receiver.receive(encode(make_batch(make_events(10, 0), 0)), out));
+  EXPECT_EQ(out.size(), 10u);
+  EXPECT_EQ(receiver.sensor(), (SensorSize{240, 180}));
+
+  const Bytes junk{1, 2, 3, 4, 5};
+  EXPECT_FALSE(receiver.receive(junk, out));
+  EXPECT_FALSE(receiver.receive(encode(make_list()), out));
+  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3, 100), 1, 7, 346, 260)), out));  // other sensor
+  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3, 100), 1, 7, 0, 180)), out));    // no sensor
+
+  // Seq 3 after 0: two lost; one event off the sensor dropped.
+  event_batch_t msg = make_batch(make_events(5, 100), 3);
+  msg.x[2] = 240;
+  ASSERT_TRUE(receiver.receive(encode(msg), out));
+  EXPECT_EQ(out.size(), 4u);
+
+  const ReceiverCounts counts = receiver.counts();
+  EXPECT_EQ(counts.invalid_messages, 4u);
+  EXPECT_EQ(counts.sequence.received, 2u);
+  EXPECT_EQ(counts.sequence.lost, 2u);
+  EXPECT_EQ(counts.drops.off_sensor, 1u);
+}
+
+TEST(EventBatchReceiver, NewEpochRestartsTheTimeOrderCheck) {
+  EventBatchReceiver receiver(SensorSize{240, 180}, 0);
+  EventBatch out;
+  ASSERT_TRUE(receiver.receive(encode(make_batch(make_events(10, 5000), 0, 1)), out));
+  EXPECT_FALSE(receiver.restarted());
+  // The same epoch going back in time: events dropped as time_backwards.
+  ASSERT_TRUE(receiver.receive(encode(make_batch(make_events(4, 10), 1, 1)), out));
+  EXPECT_TRUE(out.empty());
+  // A restarted camera whose clock starts again: accepted.
+  ASSERT_TRUE(receiver.receive(encode(make_batch(make_events(4, 10), 0, 2)), out));
+  EXPECT_TRUE(receiver.restarted());
+  EXPECT_EQ(out.size(), 4u);
+  const ReceiverCounts counts = receiver.counts();
+  EXPECT_EQ(counts.drops.time_backwards, 4u);
+  EXPECT_EQ(counts.sequence.restarts, 1u);
+}
+
+// ---- pacing -------------------------------------------------------------------------------------
+
+TEST(Pacer, UnlimitedSpeedNeverWaits) {
+  Pacer pacer(0);
+  std::atomic<bool> stop{false};
+  const auto start = std::chrono::steady_clock::now();
+  pacer.wait_until(0, stop);
+  pacer.wait_until(3'600'000'000, stop);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+}
+
+TEST(Pacer, WaitsForEventTimeAndHonoursStop) {
+  Pacer pacer(1.0);
+  std::atomic<bool> stop{false};
+  pacer.wait_until(0, stop);  // anchors
+  const auto start = std::chrono::steady_clock::now();
+  pacer.wait_until(30'000, stop);  // 30 ms later
+  EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(29));
+  stop = true;
+  const auto stopped = std::chrono::steady_clock::now();
+  pacer.wait_until(3'600'000'000, stop);  // an hour, but stop is set
+  EXPECT_LT(std::chrono::steady_clock::now() - stopped, std::chrono::seconds(1));
+}
+
+// ---- lcm-logger files ---------------------------------------------------------------------------
+
+class LcmLogFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("evldt_transport_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  static void write(lcm::LogFile& log, const std::string& channel, const Bytes& bytes, std::int64_t timestamp) {
+    lcm::LogEvent event{};
+    event.timestamp = timestamp;
+    event.channel = channel;
+    event.datalen = static_cast<std::int32_t>(bytes.size());
+    event.data = const_cast<std::uint8_t*>(bytes.data());
+    ASSERT_EQ(log.writeEvent(&event), 0);
+  }
+
+  // Three batches of 100 events with junk and another camera interleaved, then two segment lists of
+  // the same lattice time (the later one wins) and one of a later time.
+  std::filesystem::path write_log() {
+    const auto path = dir_ / "run.lcmlog";
+    lcm::LogFile log(path.string(), "w");
+    EXPECT_TRUE(log.good());
+    for (std::int64_t seq = 0; seq < 3; ++seq) {
+      write(log, "EVENTS_CAM0", encode(make_batch(make_events(100, 1000 + seq * 1000, 10), seq)), seq);
+      write(log, "EVENTS_CAM0", Bytes{9, 9, 9}, seq);
+      write(log, "EVENTS_CAM1", encode(make_batch(make_events(7, 0), seq)), seq);
+    }
+    segment_list_t list = make_list();
+    write(log, "LINES_CAM0", encode(list), 10);
+    list.segments.pop_back();
+    list.num_segments = 1;
+    write(log, "LINES_CAM0", encode(list), 11);
+    list.t_us = 2000;
+    write(log, "LINES_CAM0", encode(list), 12);
+    return path;
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(LcmLogFiles, ReadsTheEventsOfOneCameraAndCountsJunk) {
+  const auto path = write_log();
+  EXPECT_TRUE(is_lcm_log(path));
+  LcmLogEventReader reader(path, "", 0);
+  EXPECT_EQ(reader.channel(), "EVENTS_CAM0");
+  EXPECT_EQ(reader.sensor(), (SensorSize{240, 180}));
+  EventBatch batch;
+  std::vector<Timestamp> times;
+  while (reader.read(batch)) times.insert(times.end(), batch.t.begin(), batch.t.end());
+  ASSERT_EQ(times.size(), 300u);
+  EXPECT_EQ(times.front(), 1000);
+  EXPECT_EQ(times.back(), 3000 + 99 * 10);
+  EXPECT_EQ(reader.counts().invalid_messages, 3u);
+  EXPECT_EQ(reader.counts().sequence.lost, 0u);
+  EXPECT_DOUBLE_EQ(reader.progress(), 1.0);
+}
+
+TEST_F(LcmLogFiles, ReadsSegmentListsOneStepPerLatticeTime) {
+  const auto rows = read_segment_log(write_log());
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].t_us, 1000);
+  EXPECT_EQ(rows[0].id, 42u);
+  EXPECT_EQ(rows[1].t_us, 2000);
+}
+
+TEST_F(LcmLogFiles, TruncatedLogYieldsWhatPrecedesTheCut) {
+  const auto path = write_log();
+  // Cut inside the second batch message: the first batch survives.
+  const auto size = std::filesystem::file_size(path);
+  std::filesystem::resize_file(path, 1200);
+  ASSERT_LT(1200u, size);
+  LcmLogEventReader reader(path, "EVENTS_CAM0", 0);
+  EventBatch batch;
+  std::size_t events = 0;
+  while (reader.read(batch)) events += batch.size();
+  EXPECT_EQ(events, 100u);
+  EXPECT_THROW(read_segment_log(path), std::runtime_error);  // no list survived
+}
+
+TEST_F(LcmLogFiles, MissingOrForeignFilesAreClearErrors) {
+  EXPECT_THROW(LcmLogEventReader(dir_ / "absent.lcmlog", "", 0), std::runtime_error);
+  const auto text = dir_ / "events.txt";
+  std::ofstream(text) << "0.000001 1 2 1\n";
+  EXPECT_FALSE(is_lcm_log(text));
+  const auto path = write_log();
+  EXPECT_THROW(LcmLogEventReader(path, "EVENTS_NOPE", 0), std::runtime_error);
+  EXPECT_THROW(read_segment_log(path, "LINES_NOPE"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace evldt
