@@ -98,6 +98,12 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
   std::copy(other.entries_.begin(), other.entries_.end(), entries_.begin());
 }
 
+std::size_t ScarfLattice::memory_bytes() const {
+  const std::size_t tables = column_home_.size() + column_side_.size() + row_home_.size() + row_side_.size();
+  return entries_.size() * sizeof(LatticeEntry) + blocks_.size() * sizeof(BlockState) + tables * sizeof(std::int32_t) +
+         surface_.size() * sizeof(std::uint16_t);
+}
+
 void ScarfLattice::clear() {
   std::fill(blocks_.begin(), blocks_.end(), BlockState{});
   std::fill(surface_.begin(), surface_.end(), std::uint16_t{0});

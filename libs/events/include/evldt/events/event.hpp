@@ -29,7 +29,7 @@ struct Event {
 };
 
 /// A run of events in time order, stored as structure-of-arrays: storage reads only x and y, and
-/// the LCM message carries the same typed arrays (see tools/evldt-bench for the layout measurement).
+/// the LCM message carries the same typed arrays (evldt-bench measures both layouts).
 class EventBatch {
  public:
   std::vector<Timestamp> t;

@@ -86,6 +86,8 @@ class ScarfLattice {
   /// Copies the ring contents of a lattice of the same geometry without allocating (the surface is
   /// not copied). Used by the real-time engine to give each loop a consistent view.
   void copy_state_from(const ScarfLattice& other);
+  /// Bytes of storage held (rings, block states, lookup tables, surface).
+  [[nodiscard]] std::size_t memory_bytes() const;
   void clear();
 
  private:

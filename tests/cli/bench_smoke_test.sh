@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# evldt-bench end to end at its smallest: every figure of one size is measured, positive and written
+# to the JSON (speed itself is never asserted: this machine is shared and noisy).
+# Usage: bench_smoke_test.sh EVLDT_BENCH
+set -euo pipefail
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+"$1" --sizes 240x180 --repeats 1 --min-time-ms 1 --window-ms 50 --json "$work/bench.json" >"$work/out.txt"
+cat "$work/out.txt"
+grep -q '^240x180 *boxes-6dof' "$work/out.txt"
+for key in storage_mev_s detect_hz track_hz pipeline_mev_s lattice_mb peak_rss_mb active_points lines_tracked; do
+  value=$(grep -oP "\"$key\": \K[0-9.e+-]+" "$work/bench.json")
+  awk -v v="$value" 'BEGIN { exit !(v > 0) }' || { echo "FAILED: $key = '$value'"; exit 1; }
+done
+# A wrong flag is refused with the flag named.
+if "$1" --sizes 123x45 2>"$work/err.txt"; then echo "FAILED: bad size accepted"; exit 1; fi
+grep -q -- '--sizes' "$work/err.txt"
+echo "ok"

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# The performance benchmark in one command (about 3 minutes here): builds Release, then measures the
+# core at every sensor size (evldt-bench) and the LCM path end to end (lcm-throughput-bench.sh).
+# Figures go to the terminal and to out/bench/core.json and out/bench/lcm.json.
+# Usage: tools/benchmark.sh [--quick]   (--quick: fewer repeats and 3 s per LCM speed)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+deploy/install-deps.sh
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build/release -j "$(nproc)" --target evldt-bench evldt-camera evldt-lines evldt-sim
+mkdir -p out/bench
+core_args=()
+lcm_args=()
+if [[ "${1:-}" == "--quick" ]]; then
+  core_args=(--repeats 3 --min-time-ms 30)
+  lcm_args=(--seconds 3)
+fi
+build/release/tools/evldt-bench/evldt-bench "${core_args[@]}" --json out/bench/core.json
+echo
+tools/lcm-throughput-bench.sh "${lcm_args[@]}" --json out/bench/lcm.json

@@ -1,0 +1,302 @@
+// evldt-bench: speed and memory of the core at every supported sensor size, on one core. For each
+// size a built-in scene is simulated (the first --window-ms), and each figure is the median of
+// --repeats timed repeats, each repeat long enough (--min-time-ms) for the clock not to matter.
+// Every size runs in a child process of its own, so its peak RSS is its own.
+
+#include <CLI/CLI.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "evldt/app/pipeline_options.hpp"
+#include "evldt/lines/deterministic_pipeline.hpp"
+#include "evldt/sim/event_simulator.hpp"
+#include "evldt/sim/scenes.hpp"
+
+namespace {
+
+using namespace evldt;
+using Clock = std::chrono::steady_clock;
+
+struct SizeCase {
+  const char* label;
+  const char* scene;
+};
+// One scene per supported sensor size; 640x480 is the dense scene of the performance targets.
+constexpr SizeCase kCases[] = {
+    {"240x180", "boxes-6dof"},
+    {"346x260", "multi-speed"},
+    {"640x480", "three-lines-fast"},
+    {"1280x720", "monitor-hd"},
+};
+
+/// A timed figure: seconds per operation over the repeats.
+struct Timing {
+  double median = 0, min = 0, max = 0;
+};
+
+/// What one size measures; plain data, sent from the child process through a pipe.
+struct Figures {
+  double events = 0;            ///< simulated events in the window
+  double scene_rate_mev_s = 0;  ///< their rate in the scene
+  Timing storage;               ///< per event
+  Timing storage_aos;           ///< per event, from an array of Event structs
+  Timing detect;                ///< per pass, every block free
+  double active_points = 0;     ///< active entries in the lattice the passes see
+  double lines_created = 0;
+  Timing track;                 ///< per pass
+  double lines_tracked = 0;
+  Timing snapshot;              ///< per full lattice copy (the real-time loops' consistent view)
+  Timing pipeline;              ///< per event, the whole deterministic pipeline from an empty state
+  double lattice_mb = 0;        ///< one lattice's storage
+  double events_mb = 0;         ///< the simulated events (part of the RSS, not of evldt's state)
+  double peak_rss_mb = 0;
+};
+
+struct BenchSettings {
+  int repeats = 5;
+  double min_time_s = 0.1;
+  Timestamp window_us = 300000;
+};
+
+/// Runs `op` enough times per repeat to last min_time_s, `repeats` times; seconds per call of `op`.
+Timing time_op(const BenchSettings& settings, const std::function<void()>& op) {
+  op();  // warm caches and first-touch pages
+  std::size_t calls = 1;
+  for (;;) {
+    const auto start = Clock::now();
+    for (std::size_t i = 0; i < calls; ++i) op();
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (elapsed >= settings.min_time_s || calls >= (std::size_t{1} << 30)) break;
+    calls = elapsed > 0 ? std::max(calls * 2, static_cast<std::size_t>(static_cast<double>(calls) * settings.min_time_s / elapsed * 1.2))
+                        : calls * 16;
+  }
+  std::vector<double> per_call;
+  for (int r = 0; r < settings.repeats; ++r) {
+    const auto start = Clock::now();
+    for (std::size_t i = 0; i < calls; ++i) op();
+    per_call.push_back(std::chrono::duration<double>(Clock::now() - start).count() / static_cast<double>(calls));
+  }
+  std::sort(per_call.begin(), per_call.end());
+  return {per_call[per_call.size() / 2], per_call.front(), per_call.back()};
+}
+
+Timing per_item(Timing t, double items) {
+  return {t.median / items, t.min / items, t.max / items};
+}
+
+double peak_rss_mb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;  // kB
+  }
+  return 0;
+}
+
+EventBatch simulate(const Scene& scene, Timestamp window_us) {
+  Scene windowed = scene;
+  windowed.duration_us = std::min(scene.duration_us, window_us);
+  EventSimulator simulator(windowed, SimulatorConfig{});
+  EventBatch events;
+  while (simulator.run_until(simulator.now_us() + 10000, events)) {
+  }
+  return events;
+}
+
+Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
+  const Scene scene = make_scene(size_case.scene);
+  const EventBatch events = simulate(scene, settings.window_us);
+  const PipelineConfig config = default_config_for(scene.sensor);
+  const auto n = static_cast<double>(events.size());
+  Figures f;
+  f.events = n;
+  f.scene_rate_mev_s = events.empty() ? 0 : n / static_cast<double>(events.t.back() - events.t.front() + 1);
+  f.events_mb = n * (sizeof(Timestamp) + 2 * sizeof(std::uint16_t) + sizeof(std::int8_t)) / 1e6;
+
+  ScarfLattice lattice(scene.sensor, config.lattice.block_size, config.lattice.alpha);
+  f.lattice_mb = static_cast<double>(lattice.memory_bytes()) / 1e6;
+  f.storage = per_item(time_op(settings, [&] { lattice.insert(events); }), n);
+  std::vector<Event> structs(events.size());
+  for (std::size_t i = 0; i < events.size(); ++i) structs[i] = events[i];
+  f.storage_aos = per_item(time_op(settings, [&] {
+                             for (const Event& e : structs) lattice.insert(e.x, e.y);
+                           }),
+                           n);
+  structs = {};
+
+  // The passes run on the state at the end of the window.
+  DeterministicPipeline busy(config);
+  busy.process(events);
+  const ScarfLattice& state = busy.lattice();
+  for (int block = 0; block < state.geometry().block_count(); ++block) f.active_points += state.active_count(block);
+
+  LineDetector detector(state.geometry(), config.score);
+  LineMap detected(state.geometry());
+  f.detect = time_op(settings, [&] {
+    detected.clear();  // every block free: the most work a pass can have
+    f.lines_created = detector.detect(state, detected, 0);
+  });
+
+  LineTracker tracker(state.geometry(), config.score, config.track);
+  const LineMap start = busy.lines();
+  f.lines_tracked = static_cast<double>(start.lines().size());
+  LineMap tracked = start;
+  const Timing copy = time_op(settings, [&] { tracked = start; });
+  const Timing track_and_copy = time_op(settings, [&] {
+    tracked = start;
+    tracker.track(state, tracked, 0);
+  });
+  f.track = {track_and_copy.median - copy.median, track_and_copy.min - copy.median, track_and_copy.max - copy.median};
+
+  ScarfLattice view(scene.sensor, config.lattice.block_size, config.lattice.alpha);
+  f.snapshot = time_op(settings, [&] { view.copy_state_from(state); });
+
+  BenchSettings once = settings;
+  once.min_time_s = 0;  // a pass over the whole window is long enough
+  f.pipeline = per_item(time_op(once, [&] {
+                          DeterministicPipeline pipeline(config);
+                          pipeline.process(events);
+                        }),
+                        n);
+  f.peak_rss_mb = peak_rss_mb();
+  return f;
+}
+
+/// Runs measure() in a child process so each size's peak RSS is its own.
+std::optional<Figures> measure_in_child(const SizeCase& size_case, const BenchSettings& settings) {
+  std::fflush(nullptr);
+  int fds[2];
+  if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    close(fds[0]);
+    int status = 0;
+    try {
+      const Figures f = measure(size_case, settings);
+      status = write(fds[1], &f, sizeof f) == static_cast<ssize_t>(sizeof f) ? 0 : 1;
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "evldt-bench: %s: %s\n", size_case.label, error.what());
+      status = 1;
+    }
+    _exit(status);
+  }
+  close(fds[1]);
+  Figures f;
+  const ssize_t got = read(fds[0], &f, sizeof f);
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (got != static_cast<ssize_t>(sizeof f) || !WIFEXITED(status) || WEXITSTATUS(status) != 0) return std::nullopt;
+  return f;
+}
+
+void print_header() {
+  std::printf("%-9s %-17s %7s %9s %9s %10s %11s %10s %12s %8s %10s %9s %8s\n", "size", "scene", "Mev/s*", "storage",
+              "(AoS)", "detect", "ns/point", "track", "ns/line", "copy", "pipeline", "lattice", "RSS");
+  std::printf("%-9s %-17s %7s %9s %9s %10s %11s %10s %12s %8s %10s %9s %8s\n", "", "", "scene", "Mev/s", "Mev/s", "Hz",
+              "(points)", "Hz", "(lines)", "us", "Mev/s", "MB", "MB");
+}
+
+void print_row(const SizeCase& c, const Figures& f) {
+  char points[32], lines[32];
+  std::snprintf(points, sizeof points, "%.1f (%.0f)", f.detect.median * 1e9 / std::max(f.active_points, 1.0), f.active_points);
+  std::snprintf(lines, sizeof lines, "%.0f (%.0f)", f.track.median * 1e9 / std::max(f.lines_tracked, 1.0), f.lines_tracked);
+  std::printf("%-9s %-17s %7.2f %9.1f %9.1f %10.0f %11s %10.0f %12s %8.1f %10.2f %9.2f %8.0f\n", c.label, c.scene,
+              f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median, 1.0 / f.detect.median, points,
+              1.0 / f.track.median, lines, f.snapshot.median * 1e6, 1e-6 / f.pipeline.median, f.lattice_mb, f.peak_rss_mb);
+  std::fflush(stdout);
+}
+
+void write_timing(std::ofstream& out, const char* name, Timing t, const char* unit, double scale) {
+  out << "      \"" << name << "\": {\"unit\": \"" << unit << "\", \"median\": " << t.median * scale
+      << ", \"min\": " << t.min * scale << ", \"max\": " << t.max * scale << "},\n";
+}
+
+void write_json(const std::filesystem::path& path, const BenchSettings& settings,
+                const std::vector<std::pair<SizeCase, Figures>>& results) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+  out << "{\n  \"repeats\": " << settings.repeats << ",\n  \"min_time_s\": " << settings.min_time_s
+      << ",\n  \"window_us\": " << settings.window_us << ",\n  \"sizes\": [\n";
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const auto& [c, f] = results[i];
+    out << "    {\n      \"size\": \"" << c.label << "\",\n      \"scene\": \"" << c.scene << "\",\n"
+        << "      \"events\": " << f.events << ",\n      \"scene_rate_mev_s\": " << f.scene_rate_mev_s << ",\n";
+    write_timing(out, "storage_ns_per_event", f.storage, "ns", 1e9);
+    write_timing(out, "storage_aos_ns_per_event", f.storage_aos, "ns", 1e9);
+    write_timing(out, "detect_pass_us", f.detect, "us", 1e6);
+    write_timing(out, "track_pass_us", f.track, "us", 1e6);
+    write_timing(out, "snapshot_us", f.snapshot, "us", 1e6);
+    write_timing(out, "pipeline_ns_per_event", f.pipeline, "ns", 1e9);
+    out << "      \"storage_mev_s\": " << 1e-6 / f.storage.median << ",\n"
+        << "      \"detect_hz\": " << 1.0 / f.detect.median << ",\n"
+        << "      \"detect_ns_per_active_point\": " << f.detect.median * 1e9 / std::max(f.active_points, 1.0) << ",\n"
+        << "      \"active_points\": " << f.active_points << ",\n      \"lines_created\": " << f.lines_created << ",\n"
+        << "      \"track_hz\": " << 1.0 / f.track.median << ",\n"
+        << "      \"track_ns_per_line\": " << f.track.median * 1e9 / std::max(f.lines_tracked, 1.0) << ",\n"
+        << "      \"lines_tracked\": " << f.lines_tracked << ",\n"
+        << "      \"pipeline_mev_s\": " << 1e-6 / f.pipeline.median << ",\n"
+        << "      \"lattice_mb\": " << f.lattice_mb << ",\n      \"events_mb\": " << f.events_mb << ",\n"
+        << "      \"peak_rss_mb\": " << f.peak_rss_mb << "\n    }" << (i + 1 < results.size() ? "," : "") << "\n";
+  }
+  out << "  ]\n}\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"evldt-bench: speed and memory of SCARF storage, a detection pass, a tracking pass, the lattice\n"
+               "snapshot and the whole deterministic pipeline at every sensor size, on one core. Prints a table\n"
+               "(medians over the repeats) and writes the figures as JSON."};
+  BenchSettings settings;
+  std::vector<std::string> sizes;
+  std::filesystem::path json_path;
+  double window_ms = 300;
+  app.add_option("--sizes", sizes, "Sensor sizes to measure (default: all)")
+      ->check(CLI::IsMember({"240x180", "346x260", "640x480", "1280x720"}));
+  app.add_option("--repeats", settings.repeats, "Timed repeats per figure (the median is reported)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 101));
+  double min_time_ms = 100;
+  app.add_option("--min-time-ms", min_time_ms, "Shortest repeat; a figure's calls are batched to last this long")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 10000.0) & finite_number());
+  app.add_option("--window-ms", window_ms, "Scene time simulated per size; passes run on the state at its end")
+      ->capture_default_str()
+      ->check(CLI::Range(10.0, 10000.0) & finite_number());
+  app.add_option("--json", json_path, "Write the figures as JSON");
+  return run_main(app, argc, argv, [&] {
+    settings.window_us = static_cast<Timestamp>(window_ms * 1e3);
+    settings.min_time_s = min_time_ms * 1e-3;
+    std::printf("evldt-bench: one core, medians of %d repeats; *scene = event rate of the simulated scene\n",
+                settings.repeats);
+    print_header();
+    std::vector<std::pair<SizeCase, Figures>> results;
+    bool failed = false;
+    for (const SizeCase& c : kCases) {
+      if (!sizes.empty() && std::find(sizes.begin(), sizes.end(), c.label) == sizes.end()) continue;
+      if (const auto figures = measure_in_child(c, settings)) {
+        results.emplace_back(c, *figures);
+        print_row(c, *figures);
+      } else {
+        std::printf("%-9s %-17s failed (see the error above)\n", c.label, c.scene);
+        failed = true;
+      }
+    }
+    if (!json_path.empty()) {
+      write_json(json_path, settings, results);
+      std::printf("wrote %s\n", json_path.string().c_str());
+    }
+    return failed ? 1 : 0;
+  });
+}

@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# End-to-end LCM throughput on loopback: evldt-camera replays a simulated recording in a loop at
+# rising speed factors into evldt-lines for SECONDS each; reports per speed the event rate, batches
+# lost, CPU use of each process, bytes per event on the wire and the latency from batch publish to
+# the segment list that includes it (median / p99); then the highest rate held: zero lost batches and
+# p99 latency under --max-p99-ms (LCM queues up to 4096 batches, so a lines service that falls
+# behind shows as latency before it shows as loss).
+# Usage: tools/lcm-throughput-bench.sh [--scene NAME] [--seconds S] [--publish-hz HZ] [--speeds "1 2 4"]
+#                                      [--max-p99-ms MS] [--json FILE] [--build DIR]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=$root/build/release
+scene=monitor-hd
+seconds=10
+publish_hz=1000
+speeds="0.05 0.1 0.25 0.5 1 1.25"
+max_p99_ms=5
+json=
+while (($#)); do
+  case $1 in
+    --scene) scene=$2; shift 2 ;;
+    --seconds) seconds=$2; shift 2 ;;
+    --publish-hz) publish_hz=$2; shift 2 ;;
+    --speeds) speeds=$2; shift 2 ;;
+    --max-p99-ms) max_p99_ms=$2; shift 2 ;;
+    --json) json=$2; shift 2 ;;
+    --build) build=$2; shift 2 ;;
+    -h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "lcm-throughput-bench.sh: unknown argument $1 (see --help)" >&2; exit 1 ;;
+  esac
+done
+camera=$build/services/evldt-camera/evldt-camera
+lines=$build/services/evldt-lines/evldt-lines
+sim=$build/tools/evldt-sim/evldt-sim
+for program in "$camera" "$lines" "$sim"; do
+  [[ -x $program ]] || { echo "lcm-throughput-bench.sh: $program missing: build first" >&2; exit 1; }
+done
+"$root/deploy/multicast-route.sh"
+# A port of its own, so a running system is not disturbed.
+url="udpm://239.255.76.67:7719?ttl=0"
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  for pid in "${pids[@]}"; do kill -9 "$pid" 2>/dev/null || true; done
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+"$sim" --scene "$scene" --out-dir "$work/rec" --format evt3 --quiet >/dev/null
+recording=$work/rec/events.raw
+ticks=$(getconf CLK_TCK)
+cpu_seconds() {  # user + system CPU seconds of a live process
+  awk -v t="$ticks" '{ print ($14 + $15) / t }' "/proc/$1/stat"
+}
+field() {  # field FILE REGEX: the first number after REGEX
+  grep -oP "$2\s*\K[0-9.]+" "$1" | head -1
+}
+
+printf 'scene %s, %s s per speed, segment lists at %s Hz, %s\n' "$scene" "$seconds" "$publish_hz" "$url"
+printf '%-7s %10s %14s %11s %11s %10s %14s\n' speed "Mev/s" "batches lost" "camera CPU" "lines CPU" "B/event" "latency ms"
+rows=()
+best=0
+for speed in $speeds; do
+  "$lines" --lcm-url "$url" --publish-hz "$publish_hz" --log-period-s 0 --log-level warn >"$work/lines.out" 2>"$work/lines.err" &
+  lines_pid=$!
+  pids+=("$lines_pid")
+  sleep 0.3
+  "$camera" "$recording" --lcm-url "$url" --speed "$speed" --loop --quiet --log-level warn >"$work/camera.out" 2>"$work/camera.err" &
+  camera_pid=$!
+  pids+=("$camera_pid")
+  started=$(date +%s.%N)
+  sleep "$seconds"
+  camera_cpu=$(cpu_seconds "$camera_pid")
+  lines_cpu=$(cpu_seconds "$lines_pid")
+  wall=$(awk -v s="$started" -v e="$(date +%s.%N)" 'BEGIN { print e - s }')
+  kill -INT "$camera_pid"
+  wait "$camera_pid" || true
+  sleep 0.5  # the last lists
+  kill -INT "$lines_pid"
+  wait "$lines_pid" || true
+  rate=$(field "$work/camera.out" 'wall \([0-9.]+x\),')
+  bytes=$(field "$work/camera.out" 'MB,')
+  received=$(field "$work/lines.out" 'batches')
+  lost=$(field "$work/lines.out" 'received,')
+  median=$(field "$work/lines.out" 'median')
+  p99=$(field "$work/lines.out" 'p99')
+  camera_pct=$(awk -v c="$camera_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
+  lines_pct=$(awk -v c="$lines_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
+  printf '%-7s %10s %14s %11s %11s %10s %14s\n' "$speed" "$rate" "$lost of $received" "$camera_pct" "$lines_pct" "$bytes" "$median / $p99"
+  rows+=("{\"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99}")
+  if [[ $lost == 0 ]] && awk -v r="$rate" -v b="$best" -v p="$p99" -v m="$max_p99_ms" 'BEGIN { exit !(r > b && p < m) }'; then
+    best=$rate
+  fi
+done
+echo "highest event rate held for $seconds s with zero lost batches and p99 latency < $max_p99_ms ms: $best Mev/s"
+if [[ -n $json ]]; then
+  {
+    echo "{\"scene\": \"$scene\", \"seconds\": $seconds, \"publish_hz\": $publish_hz, \"max_p99_ms\": $max_p99_ms, \"best_mev_s\": $best, \"runs\": ["
+    (IFS=,; echo "${rows[*]}")
+    echo "]}"
+  } >"$json"
+  echo "wrote $json"
+fi
