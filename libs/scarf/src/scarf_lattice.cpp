@@ -82,11 +82,13 @@ ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool
   if (keep_surface) surface_.assign(static_cast<std::size_t>(sensor.width) * sensor.height, 0);
 }
 
-void ScarfLattice::insert(const EventBatch& batch) {
-  const std::size_t n = batch.size();
-  const std::uint16_t* xs = batch.x.data();
-  const std::uint16_t* ys = batch.y.data();
-  for (std::size_t i = 0; i < n; ++i) insert(xs[i], ys[i]);
+void ScarfLattice::insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys) {
+  const std::size_t n = std::min(xs.size(), ys.size());
+  if (surface_.empty()) {
+    for (std::size_t i = 0; i < n; ++i) insert_event<false>(xs[i], ys[i]);
+  } else {
+    for (std::size_t i = 0; i < n; ++i) insert_event<true>(xs[i], ys[i]);
+  }
 }
 
 void ScarfLattice::copy_state_from(const ScarfLattice& other) {

@@ -62,17 +62,15 @@ class ScarfLattice {
 
   /// Stores one on-sensor event (the caller validates coordinates). O(1), never allocates.
   void insert(std::uint16_t x, std::uint16_t y) {
-    const std::int32_t home_i = column_home_[x];
-    const std::int32_t home_j = row_home_[y];
-    const std::int32_t side_i = column_side_[x];
-    const std::int32_t side_j = row_side_[y];
-    const std::uint16_t y_active = static_cast<std::uint16_t>(y | LatticeEntry::kActiveBit);
-    if (home_i >= 0 && home_j >= 0) push(home_j + home_i, {x, y_active});
-    if (side_i >= 0 && home_j >= 0) push(home_j + side_i, {x, y});
-    if (home_i >= 0 && side_j >= 0) push(side_j + home_i, {x, y});
-    if (side_i >= 0 && side_j >= 0) push(side_j + side_i, {x, y});
+    if (surface_.empty()) {
+      insert_event<false>(x, y);
+    } else {
+      insert_event<true>(x, y);
+    }
   }
-  void insert(const EventBatch& batch);
+  /// Stores the on-sensor events (xs[i], ys[i]) in order; the spans have the same length.
+  void insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys);
+  void insert(const EventBatch& batch) { insert(batch.x, batch.y); }
 
   [[nodiscard]] const LatticeGeometry& geometry() const { return geometry_; }
   /// The entries a block currently holds (at most N, in no particular order).
@@ -91,29 +89,42 @@ class ScarfLattice {
   void clear();
 
  private:
-  struct BlockState {
+  struct alignas(8) BlockState {
     std::uint16_t head = 0;    ///< next slot to overwrite
     std::uint16_t filled = 0;  ///< slots in use (reaches N and stays)
     std::uint16_t active = 0;  ///< ACTIVE entries among them
   };
 
-  void push(std::int32_t block, LatticeEntry entry) {
-    BlockState& state = blocks_[block];
+  template <bool kSurface>
+  void insert_event(std::uint16_t x, std::uint16_t y) {
+    const std::int32_t home_i = column_home_[x];
+    const std::int32_t home_j = row_home_[y];
+    const std::int32_t side_i = column_side_[x];
+    const std::int32_t side_j = row_side_[y];
+    if (home_i >= 0 && home_j >= 0) push<kSurface, true>(home_j + home_i, x, y);
+    if (side_i >= 0 && home_j >= 0) push<kSurface, false>(home_j + side_i, x, y);
+    if (home_i >= 0 && side_j >= 0) push<kSurface, false>(side_j + home_i, x, y);
+    if (side_i >= 0 && side_j >= 0) push<kSurface, false>(side_j + side_i, x, y);
+  }
+
+  // Branch-free bookkeeping: whether the overwritten entry was active is data (about a third of
+  // entries are), and a branch on it mispredicts.
+  template <bool kSurface, bool kActive>
+  void push(std::int32_t block, std::uint16_t x, std::uint16_t y) {
+    BlockState state = blocks_[block];  // one 8-byte load and store instead of three read-modify-writes
     LatticeEntry& slot = entries_[static_cast<std::size_t>(block) * geometry_.capacity + state.head];
-    if (state.filled == geometry_.capacity) {
-      if (slot.active()) {
-        --state.active;
-        if (!surface_.empty()) --surface_[static_cast<std::size_t>(slot.y()) * geometry_.sensor.width + slot.x];
-      }
-    } else {
-      ++state.filled;
+    const auto full = static_cast<std::uint16_t>(state.filled == geometry_.capacity);
+    const auto evicted_active = static_cast<std::uint16_t>(full & (slot.y_and_flag >> 15));
+    if constexpr (kSurface) {
+      if (evicted_active) --surface_[static_cast<std::size_t>(slot.y()) * geometry_.sensor.width + slot.x];
+      if (kActive) ++surface_[static_cast<std::size_t>(y) * geometry_.sensor.width + x];
     }
-    slot = entry;
-    if (entry.active()) {
-      ++state.active;
-      if (!surface_.empty()) ++surface_[static_cast<std::size_t>(entry.y()) * geometry_.sensor.width + entry.x];
-    }
-    state.head = static_cast<std::uint16_t>(state.head + 1 == geometry_.capacity ? 0 : state.head + 1);
+    state.filled = static_cast<std::uint16_t>(state.filled + 1 - full);
+    state.active = static_cast<std::uint16_t>(state.active + (kActive ? 1 : 0) - evicted_active);
+    slot = {x, static_cast<std::uint16_t>(kActive ? y | LatticeEntry::kActiveBit : y)};
+    const auto next = static_cast<std::uint16_t>(state.head + 1);
+    state.head = next == geometry_.capacity ? std::uint16_t{0} : next;
+    blocks_[block] = state;
   }
 
   LatticeGeometry geometry_;
