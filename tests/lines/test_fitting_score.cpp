@@ -13,6 +13,12 @@ LatticeEntry entry(int x, int y, bool active = true) {
   return {static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y | (active ? LatticeEntry::kActiveBit : 0))};
 }
 
+PointSet point_set(const std::vector<LatticeEntry>& entries, bool include_inactive) {
+  PointSet points;
+  points.add(entries, include_inactive);
+  return points;
+}
+
 // Segment along y = 4.5 from x = 4 to 12 (|L| = 8); b = 8 so d_max = 1.6; N = 32.
 class FittingScoreTest : public ::testing::Test {
  protected:
@@ -23,7 +29,7 @@ class FittingScoreTest : public ::testing::Test {
 TEST_F(FittingScoreTest, FullRowOfInliers) {
   std::vector<LatticeEntry> points;
   for (int x = 4; x < 12; ++x) points.push_back(entry(x, 4));  // centres 4.5..11.5: bins 0..7
-  const auto s = scorer.score(segment, points, false, 32.0f);
+  const auto s = scorer.score(segment, point_set(points, false), 32.0f);
   EXPECT_FLOAT_EQ(s.occupancy, 1.0f);
   EXPECT_EQ(s.inliers, 8);
   EXPECT_FLOAT_EQ(s.effective, 0.25f);
@@ -37,7 +43,7 @@ TEST_F(FittingScoreTest, HalfOccupancyAndOutliersIgnored) {
   points.push_back(entry(9, 6));   // 2 px off the line (d1 = 2 >= 1.6): outlier
   points.push_back(entry(12, 4));  // centre at d2 = 8.5 > |L|: beyond the end
   points.push_back(entry(3, 4));   // d2 = -0.5 < 0: before the start
-  const auto s = scorer.score(segment, points, false, 32.0f);
+  const auto s = scorer.score(segment, point_set(points, false), 32.0f);
   EXPECT_FLOAT_EQ(s.occupancy, 0.5f);
   EXPECT_EQ(s.inliers, 5);
   EXPECT_FLOAT_EQ(s.score(), 0.5f * 5.0f / 32.0f);
@@ -47,34 +53,34 @@ TEST_F(FittingScoreTest, InactiveEntriesArePointsOnlyWhenAllowed) {
   std::vector<LatticeEntry> points;
   for (int x = 4; x < 8; ++x) points.push_back(entry(x, 4));
   for (int x = 8; x < 12; ++x) points.push_back(entry(x, 5, /*active=*/false));  // d1 = 1 < 1.6
-  const auto without = scorer.score(segment, points, false, 32.0f);
+  const auto without = scorer.score(segment, point_set(points, false), 32.0f);
   EXPECT_FLOAT_EQ(without.occupancy, 0.5f);
   EXPECT_EQ(without.inliers, 4);
-  const auto with = scorer.score(segment, points, true, 32.0f);
+  const auto with = scorer.score(segment, point_set(points, true), 32.0f);
   EXPECT_FLOAT_EQ(with.occupancy, 1.0f);
   EXPECT_EQ(with.inliers, 8);
   EXPECT_FLOAT_EQ(with.score(), 8.0f / 32.0f);
   EXPECT_FLOAT_EQ(with.mean_inlier_distance(), 0.5f);  // d1 = 0 for y = 4, 1 for y = 5
   // The normaliser divides r_e (k*N for a union of k blocks).
-  EXPECT_FLOAT_EQ(scorer.score(segment, points, true, 64.0f).score(), 4.0f / 32.0f);
+  EXPECT_FLOAT_EQ(scorer.score(segment, point_set(points, true), 64.0f).score(), 4.0f / 32.0f);
 }
 
 TEST_F(FittingScoreTest, OccupancyIsCappedAtOneAndDegenerateSegmentsScoreZero) {
   std::vector<LatticeEntry> points;
   for (int x = 0; x < 20; ++x) points.push_back(entry(x, 4));
   const Segment short_one{Point2(4.0f, 4.5f), Point2(6.5f, 4.5f)};  // |L| = 2.5, bins 0..2: 3/2.5 -> 1
-  EXPECT_FLOAT_EQ(scorer.score(short_one, points, false, 32.0f).occupancy, 1.0f);
+  EXPECT_FLOAT_EQ(scorer.score(short_one, point_set(points, false), 32.0f).occupancy, 1.0f);
   const Segment point_like{Point2(4.0f, 4.5f), Point2(4.0f, 4.5f)};
-  EXPECT_FLOAT_EQ(scorer.score(point_like, points, false, 32.0f).score(), 0.0f);
+  EXPECT_FLOAT_EQ(scorer.score(point_like, point_set(points, false), 32.0f).score(), 0.0f);
 }
 
 TEST(LineFit, RobustWeightsResistAnOutlier) {
   std::vector<LatticeEntry> points;
   for (int x = 0; x < 12; ++x) points.push_back(entry(x, 10));
   points.push_back(entry(6, 16));
-  points.push_back(entry(6, 17, /*active=*/false));  // inactive entries are not fitted
-  const auto plain = fit_line(points, 0);
-  const auto robust = fit_line(points, 5);
+  points.push_back(entry(6, 17, /*active=*/false));  // inactive entries are not gathered for a fit
+  const auto plain = fit_line(point_set(points, false), 0);
+  const auto robust = fit_line(point_set(points, false), 5);
   ASSERT_TRUE(plain && robust);
   const float plain_tilt = std::abs(plain->direction.y() / plain->direction.x());
   const float robust_tilt = std::abs(robust->direction.y() / robust->direction.x());
@@ -85,8 +91,8 @@ TEST(LineFit, RobustWeightsResistAnOutlier) {
 
 TEST(LineFit, NeedsTwoDistinctPixels) {
   std::vector<LatticeEntry> same(5, entry(3, 3));
-  EXPECT_FALSE(fit_line(same, 3));
-  EXPECT_FALSE(fit_line({}, 3));
+  EXPECT_FALSE(fit_line(point_set(same, false), 3));
+  EXPECT_FALSE(fit_line(PointSet{}, 3));
 }
 
 TEST(ClipToSquare, EndpointsLieOnTheBlockBorder) {

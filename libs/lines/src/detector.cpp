@@ -10,7 +10,9 @@ LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& p
     : geometry_(geometry),
       params_(params),
       scorer_(params.inlier_distance_ratio * static_cast<float>(geometry.block_size),
-              static_cast<float>(geometry.block_size) * 1.5f) {}
+              static_cast<float>(geometry.block_size) * 1.5f) {
+  points_.reserve(static_cast<std::size_t>(geometry.capacity));
+}
 
 int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now) {
   const float b = static_cast<float>(geometry_.block_size);
@@ -23,13 +25,14 @@ int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp 
       continue;
     }
     if (status != BlockStatus::NoDetect || lattice.active_count(block) < geometry_.min_points()) continue;
-    const auto entries = lattice.entries(block);
-    const auto line = fit_line(entries, params_.fit_iterations);
+    points_.clear();
+    points_.add(lattice.entries(block), /*include_inactive=*/false);
+    const auto line = fit_line(points_, params_.fit_iterations);
     if (!line) continue;
     const int i = geometry_.column(block), j = geometry_.row(block);
     const auto segment = clip_to_square(*line, geometry_.origin_x(i), geometry_.origin_y(j), b);
     if (!segment) continue;
-    const float f = scorer_.score(*segment, entries, /*use_inactive=*/false, capacity).score();
+    const float f = scorer_.score(*segment, points_, capacity).score();
     if (f > params_.fit_threshold) {
       lines.add(*segment, f, block, now);
       ++created;

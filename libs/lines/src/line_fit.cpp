@@ -36,19 +36,19 @@ struct Moments {
 
 }  // namespace
 
-std::optional<InfiniteLine> fit_line(std::span<const LatticeEntry> entries, int reweight_iterations) {
+std::optional<InfiniteLine> fit_line(const PointSet& points, int reweight_iterations) {
+  const float* xs = points.x();
+  const float* ys = points.y();
+  const std::size_t n = points.size();
   Moments moments;
-  for (const LatticeEntry& e : entries) {
-    if (e.active()) moments.add(e.cx(), e.cy(), 1.0);
-  }
+  for (std::size_t i = 0; i < n; ++i) moments.add(xs[i], ys[i], 1.0);
   InfiniteLine line;
   if (!moments.line(line)) return std::nullopt;
   for (int iteration = 0; iteration < reweight_iterations; ++iteration) {
     Moments weighted;
-    for (const LatticeEntry& e : entries) {
-      if (!e.active()) continue;
-      const float residual = std::abs(cross2(Point2(e.cx(), e.cy()) - line.point, line.direction));
-      weighted.add(e.cx(), e.cy(), 1.0 / (1.0 + residual / kFairScale));
+    for (std::size_t i = 0; i < n; ++i) {
+      const float residual = std::abs(cross2(Point2(xs[i], ys[i]) - line.point, line.direction));
+      weighted.add(xs[i], ys[i], 1.0 / (1.0 + residual / kFairScale));
     }
     if (!weighted.line(line)) return std::nullopt;
   }

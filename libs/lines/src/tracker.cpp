@@ -69,7 +69,7 @@ LineTracker::LineTracker(const LatticeGeometry& geometry, const ScoreParams& sco
       scorer_(score.inlier_distance_ratio * static_cast<float>(geometry.block_size),
               std::hypot(static_cast<float>(geometry.sensor.width), static_cast<float>(geometry.sensor.height))) {
   cells_.reserve(static_cast<std::size_t>(geometry.blocks_x + geometry.blocks_y + 2));
-  gathered_.reserve(cells_.capacity() * static_cast<std::size_t>(geometry.capacity));
+  points_.reserve(cells_.capacity() * static_cast<std::size_t>(geometry.capacity));
 }
 
 void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp now) {
@@ -107,19 +107,11 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Tim
 
   // Event set: one block lends its inactive entries too, so a line can follow an edge leaving it.
   const bool single_block = cells_.size() == 1;
-  std::span<const LatticeEntry> events;
+  points_.clear();
+  for (const int cell : cells_) points_.add(lattice.entries(cell), /*include_inactive=*/single_block);
   float normaliser = static_cast<float>(geometry_.capacity);
-  if (single_block) {
-    events = lattice.entries(cells_.front());
-  } else {
-    gathered_.clear();
-    for (const int cell : cells_) {
-      for (const LatticeEntry& e : lattice.entries(cell)) {
-        if (e.active()) gathered_.push_back(e);
-      }
-    }
-    events = gathered_;
-    if (params_.multi_block_norm == EffectiveRatioNorm::Union) normaliser *= static_cast<float>(cells_.size());
+  if (!single_block && params_.multi_block_norm == EffectiveRatioNorm::Union) {
+    normaliser *= static_cast<float>(cells_.size());
   }
 
   const Point2 direction = (line.segment.q1 - line.segment.q0).normalized();
@@ -135,9 +127,9 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Tim
       {inside(m0.base - m0.step), inside(m1.base - m1.step)},
   }};
   std::size_t best = 0;
-  ScoreBreakdown best_score = scorer_.score(hypotheses[0], events, single_block, normaliser);
+  ScoreBreakdown best_score = scorer_.score(hypotheses[0], points_, normaliser);
   for (std::size_t h = 1; h < hypotheses.size(); ++h) {
-    const ScoreBreakdown s = scorer_.score(hypotheses[h], events, single_block, normaliser);
+    const ScoreBreakdown s = scorer_.score(hypotheses[h], points_, normaliser);
     if (s.better_than(best_score)) {  // strict: a full tie keeps the current segment
       best_score = s;
       best = h;

@@ -19,6 +19,7 @@ class LineDetector {
   LatticeGeometry geometry_;
   ScoreParams params_;
   FittingScorer scorer_;
+  PointSet points_;  // scratch: the active entries of the current block
 };
 
 }  // namespace evldt

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "evldt/lines/geometry.hpp"
-#include "evldt/scarf/scarf_lattice.hpp"
+#include "evldt/lines/point_set.hpp"
 
 namespace evldt {
 
@@ -31,10 +31,9 @@ class FittingScorer {
   /// max_length: the longest segment that will be scored (the sensor diagonal is always enough).
   FittingScorer(float inlier_distance, float max_length);
 
-  /// Scores `segment` on the event set: the ACTIVE entries, plus the inactive ones when use_inactive is
-  /// set (single-block tracking, so a line can follow an edge leaving its block). r_e = inliers / normaliser.
-  ScoreBreakdown score(const Segment& segment, std::span<const LatticeEntry> entries, bool use_inactive,
-                       float normaliser);
+  /// Scores `segment` on the event set `points` (the ACTIVE entries; single-block tracking adds the
+  /// inactive ones, so a line can follow an edge leaving its block). r_e = inliers / normaliser.
+  ScoreBreakdown score(const Segment& segment, const PointSet& points, float normaliser);
 
  private:
   float inlier_distance_;

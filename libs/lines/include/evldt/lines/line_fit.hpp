@@ -3,10 +3,9 @@
 // the same M-estimator OpenCV's fitLine(DIST_FAIR) uses, so outliers of a block pull the line less.
 
 #include <optional>
-#include <span>
 
 #include "evldt/lines/geometry.hpp"
-#include "evldt/scarf/scarf_lattice.hpp"
+#include "evldt/lines/point_set.hpp"
 
 namespace evldt {
 
@@ -15,8 +14,8 @@ struct InfiniteLine {
   Point2 direction;  ///< unit direction
 };
 
-/// Fits the ACTIVE entries; nullopt when they do not define a direction (fewer than 2 distinct pixels).
-std::optional<InfiniteLine> fit_line(std::span<const LatticeEntry> entries, int reweight_iterations);
+/// Fits the points; nullopt when they do not define a direction (fewer than 2 distinct pixels).
+std::optional<InfiniteLine> fit_line(const PointSet& points, int reweight_iterations);
 
 /// The two points where the line crosses the border of the axis-aligned square [x0, x0+size] x [y0, y0+size];
 /// nullopt if it misses the square or only touches a corner.

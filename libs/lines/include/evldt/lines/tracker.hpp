@@ -44,7 +44,7 @@ class LineTracker {
   TrackParams params_;
   FittingScorer scorer_;
   std::vector<int> cells_;               // scratch: blocks under the current line
-  std::vector<LatticeEntry> gathered_;   // scratch: active entries of a multi-block line
+  PointSet points_;                      // scratch: the event set of the current line
 };
 
 }  // namespace evldt
