@@ -7,7 +7,7 @@
 namespace evldt {
 
 FittingScorer::FittingScorer(float inlier_distance, float max_length)
-    : inlier_distance_(inlier_distance), bins_(static_cast<std::size_t>(std::ceil(max_length)) / 64 + 2, 0) {}
+    : inlier_distance_(inlier_distance), bins_(static_cast<std::size_t>(std::ceil(max_length)) / 64 + 3, 0) {}
 
 ScoreBreakdown FittingScorer::score(const Segment& segment, const PointSet& points, float normaliser) {
   ScoreBreakdown result;
@@ -16,28 +16,43 @@ ScoreBreakdown FittingScorer::score(const Segment& segment, const PointSet& poin
   if (!(length > 1e-3f) || normaliser <= 0) return result;
   const Point2 unit = along / length;
   const std::size_t bin_count = static_cast<std::size_t>(length) + 1;  // floor(d2) ranges over 0..floor(|L|)
-  const std::size_t words = std::min(bins_.size(), (bin_count + 63) / 64);
+  const std::size_t words = std::min(bins_.size() - 1, (bin_count + 63) / 64);  // keeps the spare word
   std::fill_n(bins_.begin(), words, 0);
 
-  // Branch-free: about half the points are inliers, so a branch on it mispredicts. Sums and
-  // counts are taken in point order, exactly as a branchy loop would (adding 0 changes nothing).
+  // Two passes. The first is branch-free arithmetic the compiler vectorises: each point's bin, or
+  // a spare bin past the segment when it is no inlier, and its distance, or 0. The second sets the
+  // bins and sums the distances in point order, exactly as a loop over the inliers would (adding 0
+  // changes nothing).
+  const std::size_t n = points.size();
+  if (point_bins_.size() < n) {  // grows to the largest event set once, then stays
+    point_bins_.resize(n);
+    point_distances_.resize(n);
+  }
   const float q0x = segment.q0.x(), q0y = segment.q0.y(), ux = unit.x(), uy = unit.y();
   const float max_distance = inlier_distance_;
-  const std::size_t last_bin = words * 64 - 1;
+  const auto last_bin = static_cast<std::int32_t>(words * 64 - 1);
+  const std::int32_t spare_bin = last_bin + 1;  // in the spare word after the last one used
   const float* xs = points.x();
   const float* ys = points.y();
-  std::uint64_t* bins = bins_.data();
-  int inliers = 0;
-  float distance_sum = 0;
-  for (std::size_t i = 0, n = points.size(); i < n; ++i) {
+  std::int32_t* point_bins = point_bins_.data();
+  float* point_distances = point_distances_.data();
+  std::int32_t inliers = 0;
+  for (std::size_t i = 0; i < n; ++i) {
     const float ox = xs[i] - q0x, oy = ys[i] - q0y;
-    const float position = ox * ux + oy * uy;               // d2
-    const float distance = std::abs(ox * uy - oy * ux);     // d1
+    const float position = ox * ux + oy * uy;            // d2
+    const float distance = std::abs(ox * uy - oy * ux);  // d1
     const bool inlier = (distance < max_distance) & (position >= 0.0f) & (position <= length);
-    const std::size_t bin = std::min(static_cast<std::size_t>(inlier ? position : 0.0f), last_bin);
-    bins[bin / 64] |= std::uint64_t{inlier} << (bin % 64);
+    point_bins[i] = inlier ? std::min(static_cast<std::int32_t>(position), last_bin) : spare_bin;
+    point_distances[i] = inlier ? distance : 0.0f;
     inliers += inlier;
-    distance_sum += inlier ? distance : 0.0f;
+  }
+  std::uint64_t* bins = bins_.data();
+  bins[words] = 0;
+  float distance_sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto bin = static_cast<std::uint32_t>(point_bins[i]);
+    bins[bin / 64] |= std::uint64_t{1} << (bin % 64);
+    distance_sum += point_distances[i];
   }
   int occupied = 0;
   for (std::size_t w = 0; w < words; ++w) occupied += std::popcount(bins[w]);
