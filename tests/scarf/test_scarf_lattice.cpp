@@ -106,6 +106,64 @@ TEST(ScarfLattice, CopyStateGivesAnIdenticalView) {
   EXPECT_THROW(other.copy_state_from(source), std::invalid_argument);
 }
 
+void expect_same_rings(const ScarfLattice& a, const ScarfLattice& b) {
+  for (int block = 0; block < a.geometry().block_count(); ++block) {
+    ASSERT_EQ(a.active_count(block), b.active_count(block)) << block;
+    const auto ea = a.entries(block), eb = b.entries(block);
+    ASSERT_EQ(ea.size(), eb.size()) << block;
+    for (std::size_t i = 0; i < ea.size(); ++i) {
+      ASSERT_EQ(ea[i].x, eb[i].x) << block;
+      ASSERT_EQ(ea[i].y_and_flag, eb[i].y_and_flag) << block;
+    }
+  }
+}
+
+TEST(ScarfLattice, IncrementalCopyFollowsEveryChange) {
+  ScarfLattice source(kSensor, 8, 1.0), view(kSensor, 8, 1.0);
+  const auto write = [&](int count, int seed) {
+    for (int k = 0; k < count; ++k) {
+      source.insert(static_cast<std::uint16_t>((k * 7 + seed) % 64), static_cast<std::uint16_t>((k * 5 + seed * 3) % 48));
+    }
+  };
+  write(500, 0);
+  view.copy_state_from(source);
+  expect_same_rings(source, view);
+  // A few events touch a few blocks: the view follows them (and the ring wrap) exactly.
+  for (int round = 1; round < 40; ++round) {
+    source.insert(static_cast<std::uint16_t>(round % 64), 20);
+    view.copy_state_from(source);
+    expect_same_rings(source, view);
+  }
+  // A clear, then writes bringing the versions of a cleared block back to any count.
+  source.clear();
+  view.copy_state_from(source);
+  expect_same_rings(source, view);
+  write(300, 1);
+  view.copy_state_from(source);
+  expect_same_rings(source, view);
+  // A view written to itself, or updated from another lattice, is copied in full next time.
+  view.insert(30, 20);
+  view.copy_state_from(source);
+  expect_same_rings(source, view);
+  ScarfLattice other(kSensor, 8, 1.0);
+  for (int k = 0; k < 300; ++k) other.insert(static_cast<std::uint16_t>(k % 64), static_cast<std::uint16_t>(k % 48));
+  view.copy_state_from(other);
+  expect_same_rings(other, view);
+  view.copy_state_from(source);
+  expect_same_rings(source, view);
+}
+
+TEST(ScarfLattice, VersionsChangeWithEveryWriteAndClear) {
+  ScarfLattice lattice(kSensor, 8, 1.0);
+  const int block = lattice.geometry().index(3, 2);  // holds pixel (30, 22) actively
+  const std::uint64_t before = lattice.version(block);
+  lattice.insert(30, 22);
+  EXPECT_EQ(lattice.version(block), before + 1);
+  lattice.clear();
+  EXPECT_EQ(lattice.version(block), before + 2);
+  EXPECT_EQ(lattice.version(lattice.geometry().index(0, 0)), 1u);  // untouched before the clear
+}
+
 // An edge crossing the sensor at speed v leaves (per block it has passed) the same active entries
 // whatever v: the ring holds a fixed number of events, not a time window.
 TEST(ScarfLattice, ActiveEntriesPerBlockDoNotDependOnEdgeSpeed) {

@@ -44,9 +44,14 @@ void DeterministicPipeline::process(const EventBatch& batch) {
   const Timestamp* ts = batch.t.data();
   const std::uint16_t* xs = batch.x.data();
   const std::uint16_t* ys = batch.y.data();
-  for (std::size_t i = 0; i < n; ++i) {
+  std::size_t i = 0;
+  while (i < n) {
     if (ts[i] >= next_due_) run_rounds_until(ts[i]);
-    lattice_.insert(xs[i], ys[i]);
+    // The run of events before the next round, stored in one call.
+    std::size_t end = i + 1;
+    while (end < n && ts[end] < next_due_) ++end;
+    lattice_.insert(std::span(xs + i, end - i), std::span(ys + i, end - i));
+    i = end;
   }
   counters_.events += n;
 }

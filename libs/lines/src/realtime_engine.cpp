@@ -1,6 +1,8 @@
 #include "evldt/lines/realtime_engine.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <limits>
 
 namespace evldt {
 
@@ -27,10 +29,12 @@ void RealtimeEngine::start() {
     stopping_ = false;
   }
   detect_thread_ = std::thread([this] {
-    loop(detect_view_, detect_rounds_, [this](const ScarfLattice& view, Timestamp now) { detector_.detect(view, lines_, now); });
+    loop(detect_view_, detect_rounds_, config_.schedule.detect_period_us,
+         [this](const ScarfLattice& view, Timestamp now) { detector_.detect(view, lines_, now); });
   });
   track_thread_ = std::thread([this] {
-    loop(track_view_, track_rounds_, [this](const ScarfLattice& view, Timestamp now) { tracker_.track(view, lines_, now); });
+    loop(track_view_, track_rounds_, config_.schedule.track_period_us,
+         [this](const ScarfLattice& view, Timestamp now) { tracker_.track(view, lines_, now); });
   });
 }
 
@@ -50,7 +54,7 @@ void RealtimeEngine::process(const EventBatch& batch) {
     const std::size_t end = std::min(n, begin + kInsertChunk);
     {
       std::lock_guard lock(lattice_mutex_);
-      for (std::size_t i = begin; i < end; ++i) lattice_.insert(batch.x[i], batch.y[i]);
+      lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin));
       events_stored_ += end - begin;
       latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
     }
@@ -59,19 +63,29 @@ void RealtimeEngine::process(const EventBatch& batch) {
 }
 
 template <typename Round>
-void RealtimeEngine::loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds, Round round) {
+void RealtimeEngine::loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round) {
   std::uint64_t seen = 0;
+  Timestamp next_due = std::numeric_limits<Timestamp>::min();
+  const auto wall_period = std::chrono::microseconds(period_us);
   for (;;) {
     Timestamp now = 0;
     {
       std::unique_lock lock(lattice_mutex_);
-      // A round on an unchanged lattice would repeat the last one: wait for new events.
-      lattice_changed_.wait(lock, [&] { return stopping_ || events_stored_ != seen; });
+      // A round is due once a period of event time has been stored since the last one (the
+      // deterministic schedule; more rounds would repeat work the storage thread needs the CPU
+      // for). A round on an unchanged lattice would repeat the last one.
+      const auto due = [&] { return stopping_ || (events_stored_ != seen && latest_event_us_ >= next_due); };
+      if (!lattice_changed_.wait_for(lock, wall_period, due)) {
+        // A period of wall time without a period of event time (a sparse or ending stream): run
+        // on whatever is new, so the last events are never left waiting.
+        lattice_changed_.wait(lock, [&] { return stopping_ || events_stored_ != seen; });
+      }
       if (stopping_) return;
       view.copy_state_from(lattice_);
       seen = events_stored_;
       now = latest_event_us_;
     }
+    next_due = now + period_us;
     {
       std::lock_guard lock(lines_mutex_);
       round(view, now);

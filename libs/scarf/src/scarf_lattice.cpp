@@ -1,6 +1,7 @@
 #include "evldt/scarf/scarf_lattice.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -11,6 +12,11 @@ namespace {
 
 // Largest coordinate a LatticeEntry can hold (y keeps 15 bits).
 constexpr int kMaxSensorSide = 32767;
+
+std::uint64_t next_lattice_id() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
 
 }  // namespace
 
@@ -74,7 +80,7 @@ void build_axis_tables(int length, int block_size, int blocks, int stride, std::
 }  // namespace
 
 ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool keep_surface)
-    : geometry_(LatticeGeometry::make(sensor, block_size, alpha)) {
+    : geometry_(LatticeGeometry::make(sensor, block_size, alpha)), id_(next_lattice_id()) {
   build_axis_tables(sensor.width, block_size, geometry_.blocks_x, 1, column_home_, column_side_);
   build_axis_tables(sensor.height, block_size, geometry_.blocks_y, geometry_.blocks_x, row_home_, row_side_);
   blocks_.resize(static_cast<std::size_t>(geometry_.block_count()));
@@ -83,6 +89,7 @@ ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool
 }
 
 void ScarfLattice::insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys) {
+  copied_from_ = 0;
   const std::size_t n = std::min(xs.size(), ys.size());
   if (surface_.empty()) {
     for (std::size_t i = 0; i < n; ++i) insert_event<false>(xs[i], ys[i]);
@@ -96,8 +103,16 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
       other.geometry_.capacity != geometry_.capacity) {
     throw std::invalid_argument("copy_state_from: lattices differ in geometry");
   }
-  std::copy(other.blocks_.begin(), other.blocks_.end(), blocks_.begin());
-  std::copy(other.entries_.begin(), other.entries_.end(), entries_.begin());
+  const bool same_source = copied_from_ == other.versions_of();
+  const std::size_t capacity = static_cast<std::size_t>(geometry_.capacity);
+  for (std::size_t block = 0; block < blocks_.size(); ++block) {
+    if (same_source && blocks_[block].version == other.blocks_[block].version) continue;
+    blocks_[block] = other.blocks_[block];
+    // Only the filled slots: the rest is never read.
+    std::copy_n(other.entries_.begin() + static_cast<std::ptrdiff_t>(block * capacity), other.blocks_[block].filled,
+                entries_.begin() + static_cast<std::ptrdiff_t>(block * capacity));
+  }
+  copied_from_ = other.versions_of();
 }
 
 std::size_t ScarfLattice::memory_bytes() const {
@@ -107,7 +122,8 @@ std::size_t ScarfLattice::memory_bytes() const {
 }
 
 void ScarfLattice::clear() {
-  std::fill(blocks_.begin(), blocks_.end(), BlockState{});
+  copied_from_ = 0;
+  for (BlockState& state : blocks_) state = BlockState{.version = state.version + 1};
   std::fill(surface_.begin(), surface_.end(), std::uint16_t{0});
 }
 

@@ -46,7 +46,7 @@ class RealtimeEngine {
 
  private:
   template <typename Round>
-  void loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds, Round round);
+  void loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round);
 
   PipelineConfig config_;
   ScarfLattice lattice_;                      // guarded by lattice_mutex_

@@ -59,9 +59,15 @@ class ScarfLattice {
  public:
   /// keep_surface: maintain the per-pixel count of active entries (for display); costs a little per event.
   ScarfLattice(SensorSize sensor, int block_size, double alpha, bool keep_surface = false);
+  // A copy would share the id versions are compared under; copy_state_from is the way to copy.
+  ScarfLattice(const ScarfLattice&) = delete;
+  ScarfLattice& operator=(const ScarfLattice&) = delete;
+  ScarfLattice(ScarfLattice&&) = default;
+  ScarfLattice& operator=(ScarfLattice&&) = default;
 
   /// Stores one on-sensor event (the caller validates coordinates). O(1), never allocates.
   void insert(std::uint16_t x, std::uint16_t y) {
+    copied_from_ = 0;
     if (surface_.empty()) {
       insert_event<false>(x, y);
     } else {
@@ -78,21 +84,30 @@ class ScarfLattice {
     return {entries_.data() + static_cast<std::size_t>(block) * geometry_.capacity, blocks_[block].filled};
   }
   [[nodiscard]] int active_count(int block) const { return blocks_[block].active; }
+  /// Changes the block has seen (events written, clears): equal values mean identical contents, so
+  /// a reader can skip a block it has already seen in this state.
+  [[nodiscard]] std::uint64_t version(int block) const { return blocks_[block].version; }
+  /// Which lattice the versions count the changes of: this one's id, or that of the lattice this is
+  /// an unmodified copy of (copy_state_from). Versions compare only under the same value.
+  [[nodiscard]] std::uint64_t versions_of() const { return copied_from_ ? copied_from_ : id_; }
   /// Per-pixel number of active entries, row-major W x H; empty unless keep_surface was set.
   [[nodiscard]] const std::vector<std::uint16_t>& surface() const { return surface_; }
 
-  /// Copies the ring contents of a lattice of the same geometry without allocating (the surface is
-  /// not copied). Used by the real-time engine to give each loop a consistent view.
+  /// Makes this lattice's rings equal to those of a lattice of the same geometry, without allocating
+  /// (the surface is not copied): only the blocks whose version differs are copied, so a view kept
+  /// up to date costs what changed since its last update. Used by the real-time engine to give each
+  /// loop a consistent view.
   void copy_state_from(const ScarfLattice& other);
   /// Bytes of storage held (rings, block states, lookup tables, surface).
   [[nodiscard]] std::size_t memory_bytes() const;
   void clear();
 
  private:
-  struct alignas(8) BlockState {
+  struct alignas(16) BlockState {
     std::uint16_t head = 0;    ///< next slot to overwrite
     std::uint16_t filled = 0;  ///< slots in use (reaches N and stays)
     std::uint16_t active = 0;  ///< ACTIVE entries among them
+    std::uint64_t version = 0; ///< +1 per write or clear, never repeats
   };
 
   template <bool kSurface>
@@ -111,7 +126,7 @@ class ScarfLattice {
   // entries are), and a branch on it mispredicts.
   template <bool kSurface, bool kActive>
   void push(std::int32_t block, std::uint16_t x, std::uint16_t y) {
-    BlockState state = blocks_[block];  // one 8-byte load and store instead of three read-modify-writes
+    BlockState state = blocks_[block];  // one 16-byte load and store instead of four read-modify-writes
     LatticeEntry& slot = entries_[static_cast<std::size_t>(block) * geometry_.capacity + state.head];
     const auto full = static_cast<std::uint16_t>(state.filled == geometry_.capacity);
     const auto evicted_active = static_cast<std::uint16_t>(full & (slot.y_and_flag >> 15));
@@ -124,6 +139,7 @@ class ScarfLattice {
     slot = {x, static_cast<std::uint16_t>(kActive ? y | LatticeEntry::kActiveBit : y)};
     const auto next = static_cast<std::uint16_t>(state.head + 1);
     state.head = next == geometry_.capacity ? std::uint16_t{0} : next;
+    ++state.version;
     blocks_[block] = state;
   }
 
@@ -134,6 +150,10 @@ class ScarfLattice {
   std::vector<std::int32_t> column_home_, column_side_, row_home_, row_side_;
   std::vector<BlockState> blocks_;
   std::vector<LatticeEntry> entries_;
+  // Versions are only comparable with the lattice they were copied from: a process-unique id, and
+  // the id of the lattice this one is an unmodified copy of (0: none).
+  std::uint64_t id_;
+  std::uint64_t copied_from_ = 0;
   std::vector<std::uint16_t> surface_;
 };
 
