@@ -1,8 +1,9 @@
 #pragma once
 // The real-time engine (DESIGN 6): the caller's thread stores events as they arrive while detection
-// and tracking loop on their own threads as fast as new events allow. Each loop works on its own
-// copy of the lattice taken under a short lock, so storage never waits for a whole pass; the line
-// state is shared by the two loops under a second lock.
+// and tracking loop on their own threads, each starting a round once a period of event time has
+// been stored since its last (or a period of wall time has passed with anything new). Each loop
+// works on its own copy of the lattice, updated under a short lock, so storage never waits for a
+// whole pass; the line state is shared by the two loops under a second lock.
 
 #include <atomic>
 #include <condition_variable>
