@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The performance benchmark in one command (about 3 minutes here): builds Release, then measures the
 # core at every sensor size (evldt-bench) and the LCM path end to end (lcm-throughput-bench.sh).
-# Figures go to the terminal and to out/bench/core.json and out/bench/lcm.json.
+# Figures go to the terminal and to out/bench/core.json and out/bench/lcm-*.json.
 # Usage: tools/benchmark.sh [--quick]   (--quick: fewer repeats and 3 s per LCM speed)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -18,4 +18,6 @@ if [[ "${1:-}" == "--quick" ]]; then
 fi
 build/release/tools/evldt-bench/evldt-bench "${core_args[@]}" --json out/bench/core.json
 echo
-tools/lcm-throughput-bench.sh "${lcm_args[@]}" --json out/bench/lcm.json
+tools/lcm-throughput-bench.sh "${lcm_args[@]}" --scene three-lines-fast --speeds "0.5 1 2 3 4" --json out/bench/lcm-640x480.json
+echo
+tools/lcm-throughput-bench.sh "${lcm_args[@]}" --scene monitor-hd --speeds "0.1 0.25 0.5" --json out/bench/lcm-1280x720.json

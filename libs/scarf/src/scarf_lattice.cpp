@@ -105,12 +105,23 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
   }
   const bool same_source = copied_from_ == other.versions_of();
   const std::size_t capacity = static_cast<std::size_t>(geometry_.capacity);
-  for (std::size_t block = 0; block < blocks_.size(); ++block) {
-    if (same_source && blocks_[block].version == other.blocks_[block].version) continue;
-    blocks_[block] = other.blocks_[block];
-    // Only the filled slots: the rest is never read.
-    std::copy_n(other.entries_.begin() + static_cast<std::ptrdiff_t>(block * capacity), other.blocks_[block].filled,
-                entries_.begin() + static_cast<std::ptrdiff_t>(block * capacity));
+  const std::size_t count = blocks_.size();
+  const auto changed = [&](std::size_t block) { return !same_source || blocks_[block].version != other.blocks_[block].version; };
+  // Runs of changed blocks are copied with one memcpy each: where most blocks changed this is a
+  // plain copy of the lattice, where few did it touches only those.
+  for (std::size_t begin = 0; begin < count;) {
+    if (!changed(begin)) {
+      ++begin;
+      continue;
+    }
+    std::size_t end = begin + 1;
+    while (end < count && changed(end)) ++end;
+    std::copy(other.blocks_.begin() + static_cast<std::ptrdiff_t>(begin), other.blocks_.begin() + static_cast<std::ptrdiff_t>(end),
+              blocks_.begin() + static_cast<std::ptrdiff_t>(begin));
+    std::copy(other.entries_.begin() + static_cast<std::ptrdiff_t>(begin * capacity),
+              other.entries_.begin() + static_cast<std::ptrdiff_t>(end * capacity),
+              entries_.begin() + static_cast<std::ptrdiff_t>(begin * capacity));
+    begin = end;
   }
   copied_from_ = other.versions_of();
 }
