@@ -177,14 +177,16 @@ TEST(Nodes, GarbageAndForeignMessagesAreCountedNotFatal) {
   events.push_back(10, 5, 5, 1);
   events.push_back(20, 500, 5, 1);  // off the 240x180 sensor
   event_batch_t batch;
-  fill_event_batch(events, batch);
   batch.width = 240;
   batch.height = 180;
   batch.source = "test";
-  publish_raw(lcm, "EVENTS_CAM0", encode(batch));
+  std::vector<std::uint8_t> bytes;
+  encode_event_batch(batch, events, bytes);
+  publish_raw(lcm, "EVENTS_CAM0", bytes);
   batch.width = 320;  // a second sensor size on the same channel
   batch.seq = 1;
-  publish_raw(lcm, "EVENTS_CAM0", encode(batch));
+  encode_event_batch(batch, events, bytes);
+  publish_raw(lcm, "EVENTS_CAM0", bytes);
   ASSERT_TRUE(wait_for([&] { return lines.node.totals().receiver.invalid_messages == 4; }));
   lines.stop();
   const LinesNodeTotals totals = lines.node.totals();
@@ -245,10 +247,11 @@ TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
   EventBatch events;  // a vertical run of events at x = 50
   for (std::uint16_t y = 20; y < 120; ++y) events.push_back(1000 + y, 50, y, 1);
   event_batch_t batch;
-  fill_event_batch(events, batch);
   batch.width = 240;
   batch.height = 180;
-  publish_raw(lcm, "EVENTS_CAM0", encode(batch));
+  std::vector<std::uint8_t> bytes;
+  encode_event_batch(batch, events, bytes);
+  publish_raw(lcm, "EVENTS_CAM0", bytes);
   TrackedLine line;
   line.id = 9;
   line.segment = {Point2(150.5f, 20.5f), Point2(150.5f, 160.5f)};

@@ -115,22 +115,22 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
 }
 
 void CameraNode::publish(const EventBatch& batch, CameraSummary& summary) {
-  event_batch_t& msg = msg_;
-  fill_event_batch(batch, msg);
-  msg.utime = wall_clock_us();
-  msg.epoch = epoch_us_;
-  msg.seq = static_cast<std::int64_t>(summary.batches);
-  msg.source = options_.camera;
-  msg.width = static_cast<std::int16_t>(summary.sensor.width);
-  msg.height = static_cast<std::int16_t>(summary.sensor.height);
-  if (lcm_.publish(channel_, &msg) != 0) {
+  event_batch_t& header = header_;
+  header.utime = wall_clock_us();
+  header.epoch = epoch_us_;
+  header.seq = static_cast<std::int64_t>(summary.batches);
+  header.source = options_.camera;
+  header.width = static_cast<std::int16_t>(summary.sensor.width);
+  header.height = static_cast<std::int16_t>(summary.sensor.height);
+  encode_event_batch(header, batch, wire_);
+  if (lcm_.publish(channel_, wire_.data(), static_cast<unsigned>(wire_.size())) != 0) {
     // The sequence number still advances: subscribers count the batch as lost.
     if (std::has_single_bit(++summary.publish_failures)) spdlog::warn("{} batch publish(es) failed", summary.publish_failures);
   } else {
     if (!first_published_t_) first_published_t_ = batch.t.front();
     summary.event_seconds = static_cast<double>(batch.t.back() - *first_published_t_) * 1e-6;
     summary.events_published += batch.size();
-    summary.bytes += static_cast<std::uint64_t>(msg.getEncodedSize());
+    summary.bytes += wire_.size();
   }
   ++summary.batches;
 }

@@ -15,27 +15,28 @@ void EventBatchReceiver::refuse(const char* why) {
 }
 
 bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBatch& out) {
-  out.clear();
-  if (const WireError error = decode_message(payload, message_); error != WireError::None) {
+  if (const WireError error = decode_event_batch(payload, message_, out); error != WireError::None) {
+    out.clear();
     refuse(error == WireError::WrongType ? "not an evldt event_batch_t" : "malformed event_batch_t");
     return false;
   }
   const SensorSize size{message_.width, message_.height};
   if (!size.valid()) {
+    out.clear();
     refuse("invalid sensor size");
     return false;
   }
   if (sensor_ && size != *sensor_) {
+    out.clear();
     refuse("sensor size differs from the stream's");
     return false;
   }
   const std::uint64_t restarts_before = sequence_.counts().restarts;
-  if (!sequence_.observe(message_.epoch, message_.seq)) return false;
-  restarted_ = sequence_.counts().restarts != restarts_before;
-  if (!read_event_batch(message_, out)) {
-    refuse("time base out of range");
+  if (!sequence_.observe(message_.epoch, message_.seq)) {
+    out.clear();
     return false;
   }
+  restarted_ = sequence_.counts().restarts != restarts_before;
   if (!sensor_) sensor_ = size;
   if (!validator_ || restarted_) {
     // A restarted camera's clock may begin again: judge its time order afresh.

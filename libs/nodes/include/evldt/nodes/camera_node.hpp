@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "evldt/events/event_validator.hpp"
 #include "evldt/event_batch_t.hpp"
@@ -62,7 +63,8 @@ class CameraNode {
   CameraNodeOptions options_;
   std::int64_t epoch_us_;
   std::string channel_;
-  event_batch_t msg_;
+  event_batch_t header_;             // header fields of the next batch (its arrays stay empty)
+  std::vector<std::uint8_t> wire_;   // the encoded batch, reused
   std::optional<Timestamp> first_published_t_;
 };
 

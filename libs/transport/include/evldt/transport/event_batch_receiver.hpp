@@ -14,7 +14,7 @@
 namespace evldt {
 
 struct ReceiverCounts {
-  std::uint64_t invalid_messages = 0;  ///< undecodable, foreign type, bad sensor size or time base
+  std::uint64_t invalid_messages = 0;  ///< undecodable (time base out of range included), foreign type, bad sensor size
   SequenceCounts sequence;
   DropCounts drops;                    ///< events refused by the validator (before a restart included)
 };
@@ -29,7 +29,7 @@ class EventBatchReceiver {
   /// restarts the time-order check (restarted() tells).
   bool receive(std::span<const std::uint8_t> payload, EventBatch& out);
 
-  /// Header of the last accepted batch.
+  /// Header of the last accepted batch (its arrays are empty: the events went to `out`).
   [[nodiscard]] const event_batch_t& message() const { return message_; }
   [[nodiscard]] std::optional<SensorSize> sensor() const { return sensor_; }
   /// True if the last accepted batch started a new publisher epoch (not for the first batch).

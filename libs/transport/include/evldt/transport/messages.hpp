@@ -26,17 +26,21 @@ inline constexpr Timestamp kMaxBatchSpanUs = INT32_MAX;
 enum class WireError : std::uint8_t { None, WrongType, Malformed };
 std::string_view wire_error_name(WireError error);
 
-/// Decodes `bytes` into `out` if, and only if, it is a complete, well-formed message of that type.
-WireError decode_message(std::span<const std::uint8_t> bytes, event_batch_t& out);
+/// Decodes `bytes` into `out` if, and only if, it is a complete, well-formed message of that type
+/// (event batches: decode_event_batch).
 WireError decode_message(std::span<const std::uint8_t> bytes, segment_list_t& out);
 WireError decode_message(std::span<const std::uint8_t> bytes, stats_t& out);
 
-/// Fills the event arrays and time base of `msg` from `events` (header fields are the caller's).
-/// Throws std::invalid_argument if an event lies more than kMaxBatchSpanUs from the first.
-void fill_event_batch(const EventBatch& events, event_batch_t& msg);
-/// Appends the events of `msg` to `out`. Coordinates and times are not judged here (the event
-/// validator drops and counts those); false, with nothing appended, if the time base is out of range.
-bool read_event_batch(const event_batch_t& msg, EventBatch& out);
+/// Encodes an event batch straight from `events` into `out` (resized): the bytes lcm-gen's encoder
+/// writes for `header` with its arrays and time base filled from `events` (the header's own arrays
+/// and t_base_us/num_events are ignored), without building those arrays first. Throws
+/// std::invalid_argument if an event lies more than kMaxBatchSpanUs from the first.
+void encode_event_batch(const event_batch_t& header, const EventBatch& events, std::vector<std::uint8_t>& out);
+/// Decodes an event batch straight into `events` (emptied on an error): checks `bytes` as decode_message does,
+/// sets the scalar fields of `header` (its arrays are left empty) and appends the events, without
+/// building lcm-gen's arrays first. Coordinates and times are not judged here (the event validator
+/// drops and counts those); a time base out of range (negative or above 2^62) is Malformed.
+WireError decode_event_batch(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events);
 
 /// Fills the segments of `msg` (header fields are the caller's).
 void fill_segment_list(std::span<const TrackedLine> lines, segment_list_t& msg);
