@@ -181,9 +181,9 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
     for (std::size_t begin = 0; begin < events.size() && (updates < 50 || total < settings.min_time_s); begin += per_ms) {
       const std::size_t count = std::min(per_ms, events.size() - begin);
       live.insert(std::span(events.x).subspan(begin, count), std::span(events.y).subspan(begin, count));
-      const auto start = Clock::now();
+      const auto update_start = Clock::now();
       view.copy_state_from(live);
-      total += std::chrono::duration<double>(Clock::now() - start).count();
+      total += std::chrono::duration<double>(Clock::now() - update_start).count();
       ++updates;
     }
     update_seconds.push_back(total / static_cast<double>(updates));
