@@ -31,8 +31,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-batch", options.max_batch, "Most events per batch (7000 = one 64 KiB datagram)")
       ->capture_default_str()
       ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000}));
-  app.add_option("--width", width, "Sensor width, where the recording does not say")->check(CLI::Range(1, 32767));
-  app.add_option("--height", height, "Sensor height, where the recording does not say")->check(CLI::Range(1, 32767));
+  app.add_option("--width", width, "Sensor width, where the recording does not say")->check(CLI::Range(1, kMaxSensorSide));
+  app.add_option("--height", height, "Sensor height, where the recording does not say")->check(CLI::Range(1, kMaxSensorSide));
   app.add_option("--time-slack-us", options.time_slack_us, "Events older than the newest by more are dropped")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{0}, Timestamp{10'000'000}));

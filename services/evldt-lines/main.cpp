@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
     std::printf(
         "evldt-lines summary\n"
         "  batches   %llu received, %llu lost (sequence gaps), %llu late, %llu invalid messages, %llu camera restarts\n"
-        "  events    %llu stored, %llu dropped (%llu off sensor, %llu back in time)\n"
+        "  events    %llu stored, %llu dropped (%llu off sensor, %llu back in time), %llu clock resets\n"
         "  loops     %llu detection rounds, %llu tracking rounds\n"
         "  output    %llu lines created, %llu segment lists published\n"
         "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches)\n",
@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
         static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.invalid_messages),
         static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.events_stored),
         static_cast<unsigned long long>(t.receiver.drops.total()), static_cast<unsigned long long>(t.receiver.drops.off_sensor),
-        static_cast<unsigned long long>(t.receiver.drops.time_backwards), static_cast<unsigned long long>(t.detect_rounds),
+        static_cast<unsigned long long>(t.receiver.drops.time_backwards),
+        static_cast<unsigned long long>(t.receiver.drops.clock_resets), static_cast<unsigned long long>(t.detect_rounds),
         static_cast<unsigned long long>(t.track_rounds), static_cast<unsigned long long>(t.lines_created),
         static_cast<unsigned long long>(t.lists_published), t.latency.median_ms, t.latency.p99_ms, t.latency.samples);
     return 0;

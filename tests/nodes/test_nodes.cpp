@@ -177,17 +177,21 @@ TEST(Nodes, GarbageAndForeignMessagesAreCountedNotFatal) {
   events.push_back(10, 5, 5, 1);
   events.push_back(20, 500, 5, 1);  // off the 240x180 sensor
   event_batch_t batch;
-  batch.width = 240;
-  batch.height = 180;
+  batch.width = 6;  // first, a sensor too small for any lattice: refused, not adopted (nor a crash)
+  batch.height = 6;
   batch.source = "test";
   std::vector<std::uint8_t> bytes;
+  encode_event_batch(batch, EventBatch{}, bytes);
+  publish_raw(lcm, "EVENTS_CAM0", bytes);
+  batch.width = 240;
+  batch.height = 180;
   encode_event_batch(batch, events, bytes);
   publish_raw(lcm, "EVENTS_CAM0", bytes);
   batch.width = 320;  // a second sensor size on the same channel
   batch.seq = 1;
   encode_event_batch(batch, events, bytes);
   publish_raw(lcm, "EVENTS_CAM0", bytes);
-  ASSERT_TRUE(wait_for([&] { return lines.node.totals().receiver.invalid_messages == 4; }));
+  ASSERT_TRUE(wait_for([&] { return lines.node.totals().receiver.invalid_messages == 5; }));
   lines.stop();
   const LinesNodeTotals totals = lines.node.totals();
   EXPECT_EQ(totals.events_stored, 1u);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <thread>
 
 #include "evldt/transport/channels.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
@@ -218,6 +219,20 @@ TEST(Messages, UnterminatedOrOverlongStringIsMalformed) {
   EXPECT_EQ(decode_event_batch(overlong, out, events), WireError::Malformed);
 }
 
+TEST(Messages, StringWithANulBeforeItsEndIsMalformed) {
+  // Found by fuzz_segment_list_message: lcm-gen decodes "ca\0m" but encodes it back as "ca".
+  Bytes bytes = encode(make_batch(make_events(2), 0));
+  bytes[8 + 3 * 8 + 4 + 2] = 0;  // "cam0" -> "ca\00"
+  event_batch_t out;
+  EventBatch events;
+  EXPECT_EQ(decode_event_batch(bytes, out, events), WireError::Malformed);
+  segment_list_t list = make_list();
+  list.source = "cam0";
+  Bytes list_bytes = encode(list);
+  list_bytes[8 + 3 * 8 + 4 + 1] = 0;
+  EXPECT_EQ(decode_message(list_bytes, list), WireError::Malformed);
+}
+
 TEST(Messages, SegmentListWithUnknownStatusOrNanIsRefused) {
   segment_list_t msg = make_list();
   std::vector<TrackedLine> lines;
@@ -388,6 +403,31 @@ TEST(EventBatchReceiver, AdoptsSensorCountsLossAndRefusesForeignPayloads) {
   EXPECT_EQ(counts.drops.off_sensor, 1u);
 }
 
+TEST(EventBatchReceiver, RefusesSensorSizesBeyondTheLimitOrThatTheSubscriberCannotUse) {
+  // The subscriber (as evldt-lines does) accepts only sizes its lattice fits.
+  EventBatchReceiver receiver(std::nullopt, 0, [](SensorSize size) { return size.width >= 28 && size.height >= 28; });
+  EventBatch out;
+  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 0, 7, 5000, 180)), out));   // beyond kMaxSensorSide
+  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 1, 7, -240, 180)), out));   // negative
+  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 2, 7, 20, 20)), out));      // too small to use
+  EXPECT_FALSE(receiver.sensor().has_value());
+  ASSERT_TRUE(receiver.receive(encode(make_batch(make_events(3), 3, 7, 240, 180)), out));
+  EXPECT_EQ(receiver.sensor(), (SensorSize{240, 180}));
+  EXPECT_EQ(receiver.counts().invalid_messages, 3u);
+}
+
+TEST(EventBatchReceiver, AClockThatWentBackRestartsTheSubscriber) {
+  EventBatchReceiver receiver(SensorSize{240, 180}, 0);
+  EventBatch out;
+  ASSERT_TRUE(receiver.receive(encode(make_batch(make_events(10, 500'000), 0, 1)), out));
+  // Same publisher epoch, time back by 0.5 s for more than kClockResetRun events.
+  ASSERT_TRUE(receiver.receive(encode(make_batch(make_events(kClockResetRun + 10, 10, 1), 1, 1)), out));
+  EXPECT_TRUE(receiver.restarted());
+  EXPECT_EQ(out.size(), 11u);
+  EXPECT_EQ(receiver.counts().drops.clock_resets, 1u);
+  EXPECT_EQ(receiver.counts().drops.time_backwards, kClockResetRun - 1);
+}
+
 TEST(EventBatchReceiver, NewEpochRestartsTheTimeOrderCheck) {
   EventBatchReceiver receiver(SensorSize{240, 180}, 0);
   EventBatch out;
@@ -414,6 +454,23 @@ TEST(Pacer, UnlimitedSpeedNeverWaits) {
   pacer.wait_until(0, stop);
   pacer.wait_until(3'600'000'000, stop);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+}
+
+TEST(Pacer, AJumpOfEventTimeIsNotWaitedThrough) {
+  Pacer pacer(1.0);
+  std::atomic<bool> stop{false};
+  std::thread stopper([&] {
+    // Only if the pacer wrongly sleeps through the hour: end the test instead of hanging it.
+    for (int i = 0; i < 100 && !stop; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    stop = true;
+  });
+  pacer.wait_until(1'000, stop);
+  pacer.wait_until(3'600'000'000, stop);  // an hour later
+  pacer.wait_until(500, stop);            // and back
+  const bool stopped_early = stop.exchange(true);
+  stopper.join();
+  EXPECT_FALSE(stopped_early);
+  EXPECT_EQ(pacer.skipped_gaps(), 2u);
 }
 
 TEST(Pacer, WaitsForEventTimeAndHonoursStop) {

@@ -23,9 +23,9 @@ void PipelineOptions::add_to(CLI::App& app) {
   app.set_config("--config", "", "TOML file of options (keys are the long flag names, e.g. block-size = 14)");
   auto* group = app.add_option_group("Pipeline", "Line detection and tracking; unset values follow the sensor size");
   group->add_option("--width", width_, "Sensor width in pixels (default: from the recording's header)")
-      ->check(CLI::Range(1, 32767));
+      ->check(CLI::Range(1, kMaxSensorSide));
   group->add_option("--height", height_, "Sensor height in pixels (default: from the recording's header)")
-      ->check(CLI::Range(1, 32767));
+      ->check(CLI::Range(1, kMaxSensorSide));
   group->add_option("--block-size", block_size_, "SCARF block size b in pixels (even)")->check(CLI::Range(2, 128));
   group->add_option("--alpha", alpha_, "Ring capacity factor: N = floor(alpha * b * b / 2)")
       ->check(finite_number() & CLI::PositiveNumber);

@@ -40,8 +40,8 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
   std::fprintf(out, "evldt summary: %s\n", input.c_str());
   if (!input_error.empty()) std::fprintf(out, "  input error      %s\n", input_error.c_str());
   std::fprintf(out, "  events           %" PRIu64 " read, %" PRIu64 " processed, %" PRIu64 " dropped (%" PRIu64
-               " off-sensor, %" PRIu64 " time-backwards)\n",
-               events_read, counters.events, drops.total(), drops.off_sensor, drops.time_backwards);
+               " off-sensor, %" PRIu64 " time-backwards), %" PRIu64 " clock resets\n",
+               events_read, counters.events, drops.total(), drops.off_sensor, drops.time_backwards, drops.clock_resets);
   std::fprintf(out, "  event time       %.3f s (%.2f Mev/s)\n", event_seconds, event_seconds > 0 ? mev / event_seconds : 0.0);
   std::fprintf(out, "  wall time        %.3f s (%.2f Mev/s processed)\n", wall_seconds, wall_seconds > 0 ? mev / wall_seconds : 0.0);
   std::fprintf(out, "  rounds           %" PRIu64 " tracking, %" PRIu64 " detection, %" PRIu64 " skipped over gaps\n",
@@ -65,6 +65,7 @@ void RunSummary::write_json(const std::filesystem::path& path) const {
   out << "  \"input_error\": \"" << json_escape(input_error) << "\",\n";
   out << "  \"events_read\": " << events_read << ",\n  \"events_processed\": " << counters.events << ",\n";
   out << "  \"dropped_off_sensor\": " << drops.off_sensor << ",\n  \"dropped_time_backwards\": " << drops.time_backwards << ",\n";
+  out << "  \"clock_resets\": " << drops.clock_resets << ",\n";
   out << "  \"event_seconds\": " << event_seconds << ",\n  \"wall_seconds\": " << wall_seconds << ",\n";
   out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds << ",\n";
   out << "  \"skipped_rounds\": " << counters.skipped_rounds << ",\n";

@@ -22,12 +22,19 @@ std::size_t EventValidator::filter(EventBatch& batch) {
       continue;
     }
     if (newest_ != std::numeric_limits<Timestamp>::min() && t < newest_ - slack_) {
-      if (std::has_single_bit(++drops_.time_backwards)) {
-        spdlog::warn("dropped {} event(s) whose time went backwards by more than {}us (latest t={}us after {}us)",
-                     drops_.time_backwards, slack_, t, newest_);
+      if (++backwards_run_ < kClockResetRun) {
+        if (std::has_single_bit(++drops_.time_backwards)) {
+          spdlog::warn("dropped {} event(s) whose time went backwards by more than {}us (latest t={}us after {}us)",
+                       drops_.time_backwards, slack_, t, newest_);
+        }
+        continue;
       }
-      continue;
+      ++drops_.clock_resets;
+      spdlog::warn("event time went back from {}us to {}us for {} events in a row: following the new clock "
+                   "(clock reset {})", newest_, t, kClockResetRun, drops_.clock_resets);
+      newest_ = t;
     }
+    backwards_run_ = 0;
     if (t > newest_) newest_ = t;
     if (kept != i) {
       batch.t[kept] = t;

@@ -20,20 +20,21 @@ void CameraSummary::print(std::FILE* out) const {
   std::fprintf(out,
                "evldt-camera summary\n"
                "  source            %s (%dx%d)%s\n"
-               "  events            %llu read, %llu published, %llu dropped (%llu off sensor, %llu back in time)\n"
+               "  events            %llu read, %llu published, %llu dropped (%llu off sensor, %llu back in time), %llu clock resets\n"
                "  batches           %llu (%.1f events each), %.2f MB, %.2f bytes/event, %llu publish failures\n"
                "  time              %.3f s of events in %.3f s wall (%.2fx), %.2f Mev/s, %llu loop restarts\n"
-               "  pace              furthest behind: %.1f ms\n",
+               "  pace              furthest behind: %.1f ms, %llu jumps of event time not waited through\n",
                source.c_str(), sensor.width, sensor.height, input_error.empty() ? "" : (" -- " + input_error).c_str(),
                static_cast<unsigned long long>(events_read), static_cast<unsigned long long>(events_published),
                static_cast<unsigned long long>(drops.total()), static_cast<unsigned long long>(drops.off_sensor),
-               static_cast<unsigned long long>(drops.time_backwards), static_cast<unsigned long long>(batches),
+               static_cast<unsigned long long>(drops.time_backwards), static_cast<unsigned long long>(drops.clock_resets),
+               static_cast<unsigned long long>(batches),
                batches ? static_cast<double>(events_published) / static_cast<double>(batches) : 0.0,
                static_cast<double>(bytes) * 1e-6,
                events_published ? static_cast<double>(bytes) / static_cast<double>(events_published) : 0.0,
                static_cast<unsigned long long>(publish_failures), event_seconds, wall_seconds,
                wall_seconds > 0 ? event_seconds / wall_seconds : 0.0, rate * 1e-6,
-               static_cast<unsigned long long>(loops), max_lag_s * 1e3);
+               static_cast<unsigned long long>(loops), max_lag_s * 1e3, static_cast<unsigned long long>(skipped_gaps));
 }
 
 CameraNode::CameraNode(lcm::LCM& lcm, CameraNodeOptions options, std::int64_t epoch_us)
@@ -52,8 +53,9 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   if (!sensor) {
     throw std::runtime_error(source->name() + " has no sensor size in its header: pass --width and --height");
   }
-  if (!sensor->valid() || sensor->width > INT16_MAX || sensor->height > INT16_MAX) {
-    throw std::runtime_error("sensor size must be between 1x1 and 32767x32767");
+  if (!sensor->valid()) {
+    throw std::runtime_error("sensor size " + std::to_string(sensor->width) + "x" + std::to_string(sensor->height) +
+                             " is not in 1x1.." + std::to_string(kMaxSensorSide) + "x" + std::to_string(kMaxSensorSide));
   }
   summary.sensor = *sensor;
   EventValidator validator(*sensor, options_.time_slack_us);
@@ -110,6 +112,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   }
   publish_ready(true);
   summary.drops = validator.drops();
+  summary.skipped_gaps = pacer.skipped_gaps();
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();
   return summary;
 }

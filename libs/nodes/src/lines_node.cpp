@@ -22,7 +22,10 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
       options_(std::move(options)),
       epoch_us_(epoch_us),
       lines_channel_(lines_channel(options_.camera)),
-      receiver_(options_.sensor, options_.time_slack_us),
+      receiver_(options_.sensor, options_.time_slack_us,
+                [this](SensorSize size) {
+                  return LatticeGeometry::fits(size, options_.configure(size).lattice.block_size);
+                }),
       next_line_id_(static_cast<std::uint64_t>(epoch_us)) {
   batch_.reserve(1 << 16);
   if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100)) {
@@ -59,12 +62,12 @@ void LinesNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) 
 }
 
 void LinesNode::start_engine() {
-  // First batch, or the camera restarted (its clock may begin again): a fresh lattice and lines.
+  // First batch, or the camera restarted or its clock went back: a fresh lattice and lines.
   EngineCounters retired;
   if (engine_) {
     engine_->stop();  // the publisher may still snapshot it meanwhile
     retired = engine_->counters();
-    spdlog::warn("camera {} restarted (epoch {}): lattice and lines begin afresh", options_.camera,
+    spdlog::warn("camera {} restarted (epoch {}) or its clock went back: lattice and lines begin afresh", options_.camera,
                  receiver_.message().epoch);
   } else {
     const SensorSize sensor = *receiver_.sensor();

@@ -26,7 +26,9 @@ void put_line(cv::Mat& canvas, const std::string& text, int row) {
 }  // namespace
 
 VizNode::VizNode(lcm::LCM& lcm, VizNodeOptions options)
-    : lcm_(lcm), options_(std::move(options)), receiver_(options_.sensor, options_.time_slack_us) {
+    : lcm_(lcm), options_(std::move(options)), receiver_(options_.sensor, options_.time_slack_us, [](SensorSize size) {
+        return LatticeGeometry::fits(size, default_config_for(size).lattice.block_size);
+      }) {
   if (!(options_.render_hz > 0 && options_.render_hz <= 1000)) throw std::invalid_argument("render rate must be in (0, 1000] Hz");
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
   subscriptions_.push_back(lcm_.subscribe(events_channel(options_.camera), &VizNode::on_events, this));

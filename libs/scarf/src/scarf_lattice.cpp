@@ -10,8 +10,8 @@ namespace evldt {
 
 namespace {
 
-// Largest coordinate a LatticeEntry can hold (y keeps 15 bits).
-constexpr int kMaxSensorSide = 32767;
+// A LatticeEntry keeps 15 bits of y.
+static_assert(kMaxSensorSide <= 32767);
 
 std::uint64_t next_lattice_id() {
   static std::atomic<std::uint64_t> next{1};
@@ -21,7 +21,7 @@ std::uint64_t next_lattice_id() {
 }  // namespace
 
 LatticeGeometry LatticeGeometry::make(SensorSize sensor, int block_size, double alpha) {
-  if (!sensor.valid() || sensor.width > kMaxSensorSide || sensor.height > kMaxSensorSide) {
+  if (!sensor.valid()) {
     throw std::invalid_argument("sensor size " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height) +
                                 " is not in 1.." + std::to_string(kMaxSensorSide));
   }

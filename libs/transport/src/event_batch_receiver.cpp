@@ -1,12 +1,14 @@
 #include "evldt/transport/event_batch_receiver.hpp"
 
 #include <bit>
+#include <utility>
 #include <spdlog/spdlog.h>
 
 namespace evldt {
 
-EventBatchReceiver::EventBatchReceiver(std::optional<SensorSize> sensor, Timestamp backwards_slack_us)
-    : sensor_(sensor), slack_(backwards_slack_us) {
+EventBatchReceiver::EventBatchReceiver(std::optional<SensorSize> sensor, Timestamp backwards_slack_us,
+                                       SensorCheck usable)
+    : sensor_(sensor), slack_(backwards_slack_us), usable_(std::move(usable)) {
   if (sensor_) validator_.emplace(*sensor_, slack_);
 }
 
@@ -31,6 +33,11 @@ bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBat
     refuse("sensor size differs from the stream's");
     return false;
   }
+  if (!sensor_ && usable_ && !usable_(size)) {
+    out.clear();
+    refuse("sensor size this subscriber cannot work with");
+    return false;
+  }
   const std::uint64_t restarts_before = sequence_.counts().restarts;
   if (!sequence_.observe(message_.epoch, message_.seq)) {
     out.clear();
@@ -43,10 +50,14 @@ bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBat
     if (validator_) {
       drops_before_restart_.off_sensor += validator_->drops().off_sensor;
       drops_before_restart_.time_backwards += validator_->drops().time_backwards;
+      drops_before_restart_.clock_resets += validator_->drops().clock_resets;
     }
     validator_.emplace(*sensor_, slack_);
   }
+  const std::uint64_t clock_resets_before = validator_->drops().clock_resets;
   validator_->filter(out);
+  // A clock that went back is a restart for the subscriber as well: its state belongs to the old clock.
+  if (validator_->drops().clock_resets != clock_resets_before) restarted_ = true;
   return true;
 }
 
@@ -58,6 +69,7 @@ ReceiverCounts EventBatchReceiver::counts() const {
   if (validator_) {
     counts.drops.off_sensor += validator_->drops().off_sensor;
     counts.drops.time_backwards += validator_->drops().time_backwards;
+    counts.drops.clock_resets += validator_->drops().clock_resets;
   }
   return counts;
 }

@@ -45,11 +45,13 @@ class WireWalker {
     return true;
   }
   [[nodiscard]] const std::uint8_t* here() const { return bytes_.data() + pos_; }
-  /// An LCM string: int32 length including the terminating NUL, then the bytes.
+  /// An LCM string: int32 length including the terminating NUL, then the bytes. A NUL before the
+  /// end is refused: lcm-gen's encoder stops at the first NUL, so no evldt publisher sends one.
   bool skip_string() {
     std::int32_t length = 0;
     if (!read_i32(length) || length < 1 || static_cast<std::size_t>(length) > remaining()) return false;
-    if (bytes_[pos_ + static_cast<std::size_t>(length) - 1] != 0) return false;
+    const auto text = static_cast<std::size_t>(length) - 1;
+    if (std::memchr(bytes_.data() + pos_, 0, text + 1) != bytes_.data() + pos_ + text) return false;
     pos_ += static_cast<std::size_t>(length);
     return true;
   }

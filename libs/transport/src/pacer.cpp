@@ -8,6 +8,11 @@ namespace evldt {
 
 double Pacer::wait_until(Timestamp t, const std::atomic<bool>& stop) {
   if (!(speed_ > 0) || std::isinf(speed_)) return 0.0;
+  if (anchored_ && (t - last_t_ > kMaxWaitedGapUs || t < last_t_)) {
+    ++skipped_gaps_;
+    anchored_ = false;
+  }
+  last_t_ = t;
   if (!anchored_) {
     anchored_ = true;
     anchor_wall_ = Clock::now();

@@ -10,12 +10,20 @@ namespace evldt {
 /// Event time in microseconds.
 using Timestamp = std::int64_t;
 
+/// Largest sensor side evldt works with. Above every event camera made (1280x960 at most today);
+/// the bound keeps a forged size in a file header or a message from claiming unbounded memory
+/// (the lattice of a 4096x4096 sensor takes about 35 MB).
+inline constexpr int kMaxSensorSide = 4096;
+
 struct SensorSize {
   int width = 0;
   int height = 0;
 
   [[nodiscard]] bool contains(int x, int y) const { return x >= 0 && y >= 0 && x < width && y < height; }
-  [[nodiscard]] bool valid() const { return width > 0 && height > 0; }
+  /// Both sides in 1..kMaxSensorSide.
+  [[nodiscard]] bool valid() const {
+    return width > 0 && height > 0 && width <= kMaxSensorSide && height <= kMaxSensorSide;
+  }
   friend bool operator==(const SensorSize&, const SensorSize&) = default;
 };
 

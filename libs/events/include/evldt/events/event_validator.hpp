@@ -1,6 +1,9 @@
 #pragma once
 // Validation of events from the outside world: events off the sensor or with time going backwards
-// are dropped and counted, never stored.
+// are dropped and counted, never stored. A long run of events all behind the newest time means that
+// time itself went back (a camera clock reset, or one corrupt event far in the future): the
+// validator then follows the new clock and counts a clock reset, so one bad timestamp cannot make
+// it drop the rest of a stream.
 
 #include <cstdint>
 
@@ -11,8 +14,13 @@ namespace evldt {
 struct DropCounts {
   std::uint64_t off_sensor = 0;
   std::uint64_t time_backwards = 0;
+  std::uint64_t clock_resets = 0;  ///< times the validator followed a clock that went back (no event dropped)
   [[nodiscard]] std::uint64_t total() const { return off_sensor + time_backwards; }
 };
+
+/// Consecutive events behind the newest time (beyond the slack) after which the clock is taken to
+/// have gone back: at 1 Mev/s, a millisecond of events.
+inline constexpr std::uint64_t kClockResetRun = 1000;
 
 class EventValidator {
  public:
@@ -32,6 +40,7 @@ class EventValidator {
   Timestamp slack_;
   Timestamp newest_;
   std::uint64_t accepted_ = 0;
+  std::uint64_t backwards_run_ = 0;
   DropCounts drops_;
 };
 

@@ -41,6 +41,7 @@ struct CameraSummary {
   double event_seconds = 0;          ///< event time spanned by the published batches
   double wall_seconds = 0;
   double max_lag_s = 0;              ///< furthest behind the pace
+  std::uint64_t skipped_gaps = 0;    ///< jumps of event time not waited through (Pacer)
   std::string input_error;           ///< set if the source ended in a format error
 
   void print(std::FILE* out) const;

@@ -42,6 +42,10 @@ struct LatticeGeometry {
 
   /// Throws std::invalid_argument with a clear message on an unusable combination.
   static LatticeGeometry make(SensorSize sensor, int block_size, double alpha);
+  /// True if the sensor is valid and holds at least one block of that size (two block sides each way).
+  static bool fits(SensorSize sensor, int block_size) {
+    return sensor.valid() && block_size > 0 && sensor.width / block_size >= 2 && sensor.height / block_size >= 2;
+  }
 
   [[nodiscard]] int block_count() const { return blocks_x * blocks_y; }
   [[nodiscard]] int index(int i, int j) const { return j * blocks_x + i; }

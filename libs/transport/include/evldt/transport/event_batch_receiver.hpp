@@ -4,6 +4,7 @@
 // its events validated. Whatever is refused is counted and logged, never fatal.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 
@@ -21,8 +22,12 @@ struct ReceiverCounts {
 
 class EventBatchReceiver {
  public:
-  /// `sensor`: the size batches must have; unset: the first valid batch's size is adopted.
-  EventBatchReceiver(std::optional<SensorSize> sensor, Timestamp backwards_slack_us);
+  /// Whether the subscriber can work with a sensor of that size (e.g. its lattice fits).
+  using SensorCheck = std::function<bool(SensorSize)>;
+
+  /// `sensor`: the size batches must have; unset: the first valid batch's size is adopted, if
+  /// `usable` (when given) accepts it. Sizes outside 1..kMaxSensorSide are always refused.
+  EventBatchReceiver(std::optional<SensorSize> sensor, Timestamp backwards_slack_us, SensorCheck usable = {});
 
   /// Decodes `payload`; if it is a valid, current batch, fills `out` (cleared) with its valid
   /// events and returns true (`out` may then be empty). A batch of a newer publisher epoch
@@ -32,7 +37,8 @@ class EventBatchReceiver {
   /// Header of the last accepted batch (its arrays are empty: the events went to `out`).
   [[nodiscard]] const event_batch_t& message() const { return message_; }
   [[nodiscard]] std::optional<SensorSize> sensor() const { return sensor_; }
-  /// True if the last accepted batch started a new publisher epoch (not for the first batch).
+  /// True if the last accepted batch started a new publisher epoch (not for the first batch), or its
+  /// events made the validator follow a clock that went back.
   [[nodiscard]] bool restarted() const { return restarted_; }
   [[nodiscard]] ReceiverCounts counts() const;
 
@@ -41,6 +47,7 @@ class EventBatchReceiver {
 
   std::optional<SensorSize> sensor_;
   Timestamp slack_;
+  SensorCheck usable_;
   std::optional<EventValidator> validator_;
   DropCounts drops_before_restart_;
   SequenceTracker sequence_;
