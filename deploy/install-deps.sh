@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Installs the Debian packages evldt builds and runs with, if any is missing (apt-get, as root).
+# Installs the Debian packages evldt builds and runs with, and any given as arguments, if any is
+# missing (apt-get, as root). Usage: deploy/install-deps.sh [EXTRA_PACKAGE...]
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config
   liblcm-dev liblcm-bin liblcm-java libeigen3-dev libopencv-dev libspdlog-dev libcli11-dev
-  libgtest-dev libjchart2d-java default-jdk-headless)
+  libgtest-dev libjchart2d-java default-jdk-headless "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

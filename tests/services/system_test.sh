@@ -6,19 +6,7 @@
 set -uo pipefail
 build=$1
 source_dir=$2
-work=$(mktemp -d)
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill -9 "$pid" 2>/dev/null; done
-  rm -rf "$work"
-}
-trap cleanup EXIT
-failures=0
-check() {  # check DESCRIPTION COMMAND...
-  local what=$1
-  shift
-  if "$@"; then echo "ok: $what"; else echo "FAILED: $what"; failures=$((failures + 1)); fi
-}
+source "$source_dir/tests/services/test_lib.sh"
 camera=$build/services/evldt-camera/evldt-camera
 lines=$build/services/evldt-lines/evldt-lines
 viz=$build/services/evldt-viz/evldt-viz
@@ -29,26 +17,6 @@ junk=$build/tests/lcm_publish_junk
 url="udpm://239.255.76.67:7711?ttl=0"
 replay_url="udpm://239.255.76.67:7712?ttl=0"
 scene=(--scene boxes-6dof --duration-s 1.5)
-
-# Sends SIGTERM (or $2) and checks the process is gone within a second.
-stops_within_a_second() {
-  local pid=$1 signal=${2:-TERM}
-  kill -s "$signal" "$pid"
-  for _ in $(seq 20); do
-    kill -0 "$pid" 2>/dev/null || { wait "$pid"; return 0; }
-    sleep 0.05
-  done
-  return 1
-}
-field() {  # field FILE REGEX: the first number after REGEX
-  grep -oP "$2\s*\K[0-9.]+" "$1" | head -1
-}
-f_at_1_percent() {  # the F of the first tolerance (1%) in an evldt-eval JSON
-  grep -oP '"f"\s*:\s*\K[0-9.]+' "$1" | head -1
-}
-close_to() {  # close_to A B TOLERANCE: both numbers present and |A - B| <= TOLERANCE
-  [[ -n $1 && -n $2 ]] && awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= tol) }'
-}
 
 # --- live run ---------------------------------------------------------------------------------
 lcm-logger --lcm-url="$url" -f -q "$work/live.lcm" &
@@ -126,5 +94,4 @@ else
   echo "skipped: lcm-spy decoding (no javac or no jar)"
 fi
 
-echo "$failures failure(s)"
-exit $((failures > 0))
+finish

@@ -1,0 +1,49 @@
+// Test helper: a lossy link. Forwards every message from one channel to another unchanged, except
+// one in every DROP_EVERY, which it drops (the datagram loss tc netem would make, where the kernel
+// has no netem): the middle one of each DROP_EVERY, so that a stream of whole cycles does not end
+// on a loss, which no sequence gap could reveal. Prints what it forwarded and dropped when SECONDS
+// have passed.
+// Usage: lcm_lossy_relay URL FROM_CHANNEL TO_CHANNEL DROP_EVERY SECONDS
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+
+namespace {
+
+struct Relay {
+  lcm::LCM* lcm = nullptr;
+  std::string to;
+  long drop_every = 0;
+  long seen = 0;
+  long dropped = 0;
+  void on_message(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    if (++seen % drop_every == drop_every / 2) {
+      ++dropped;
+      return;
+    }
+    lcm->publish(to, buffer->data, buffer->data_size);
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 6 || std::atol(argv[4]) < 1) {
+    std::fprintf(stderr, "usage: %s URL FROM_CHANNEL TO_CHANNEL DROP_EVERY SECONDS\n", argv[0]);
+    return 1;
+  }
+  lcm::LCM lcm(argv[1]);
+  if (!lcm.good()) return 1;
+  Relay relay{&lcm, argv[3], std::atol(argv[4])};
+  lcm::Subscription* subscription = lcm.subscribe(argv[2], &Relay::on_message, &relay);
+  subscription->setQueueCapacity(10000);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::atof(argv[5]));
+  while (std::chrono::steady_clock::now() < end) {
+    if (lcm.handleTimeout(50) < 0) return 1;
+  }
+  std::printf("relayed %ld dropped %ld\n", relay.seen - relay.dropped, relay.dropped);
+  return 0;
+}
