@@ -66,7 +66,8 @@ TEST(PipelineOptions, BadValuesAndUnknownKeysAreRefused) {
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "unknown.toml") << "block-size = 8\nblock_sise = 3\n";
   std::ofstream(dir / "typed.toml") << "block-size = \"eight\"\n";
-  PipelineOptions a, b, c, d, e, f, g;
+  std::ofstream(dir / "zero.toml") << "width = 0\nheight = 480\n";
+  PipelineOptions a, b, c, d, e, f, g, h, i;
   EXPECT_NE(parse({"--config", (dir / "unknown.toml").string()}, a), 0);
   EXPECT_NE(parse({"--config", (dir / "typed.toml").string()}, b), 0);
   EXPECT_NE(parse({"--config", (dir / "missing.toml").string()}, c), 0);
@@ -74,6 +75,8 @@ TEST(PipelineOptions, BadValuesAndUnknownKeysAreRefused) {
   EXPECT_NE(parse({"--block-size", "-4"}, e), 0);
   EXPECT_NE(parse({"--multi-block-norm", "sum"}, f), 0);
   EXPECT_NE(parse({"--alpha", "inf"}, g), 0);
+  EXPECT_NE(parse({"--width", "5000", "--height", "480"}, h), 0);  // beyond kMaxSensorSide
+  EXPECT_NE(parse({"--config", (dir / "zero.toml").string()}, i), 0);
   PipelineOptions half;
   ASSERT_EQ(parse({"--width", "640"}, half), 0);
   EXPECT_THROW(static_cast<void>(half.sensor()), std::invalid_argument);

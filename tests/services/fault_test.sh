@@ -12,12 +12,6 @@ set -uo pipefail
 build=$1
 source_dir=$2
 source "$source_dir/tests/services/test_lib.sh"
-camera=$build/services/evldt-camera/evldt-camera
-lines=$build/services/evldt-lines/evldt-lines
-viz=$build/services/evldt-viz/evldt-viz
-eval_tool=$build/tools/evldt-eval/evldt-eval
-probe=$build/tests/lcm_lines_probe
-relay=$build/tests/lcm_lossy_relay
 url="udpm://239.255.76.67:7713?ttl=0"
 now_us() { date +%s%6N; }
 

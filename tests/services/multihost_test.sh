@@ -9,11 +9,6 @@ set -uo pipefail
 build=$1
 source_dir=$2
 source "$source_dir/tests/services/test_lib.sh"
-camera=$build/services/evldt-camera/evldt-camera
-lines=$build/services/evldt-lines/evldt-lines
-viz=$build/services/evldt-viz/evldt-viz
-probe=$build/tests/lcm_lines_probe
-junk=$build/tests/lcm_publish_junk
 url="udpm://239.255.76.67:7714?ttl=1"
 tag=evldt$$
 switch=${tag}sw

@@ -7,12 +7,6 @@ set -uo pipefail
 build=$1
 source_dir=$2
 source "$source_dir/tests/services/test_lib.sh"
-camera=$build/services/evldt-camera/evldt-camera
-lines=$build/services/evldt-lines/evldt-lines
-viz=$build/services/evldt-viz/evldt-viz
-offline=$build/tools/evldt-offline/evldt-offline
-eval_tool=$build/tools/evldt-eval/evldt-eval
-junk=$build/tests/lcm_publish_junk
 # Ports of this test only, so concurrent tests never hear each other.
 url="udpm://239.255.76.67:7711?ttl=0"
 replay_url="udpm://239.255.76.67:7712?ttl=0"

@@ -1,5 +1,14 @@
-# Shared by the service test scripts (sourced): checks that count failures, stopping processes,
-# reading numbers out of summaries. Background processes are killed and $work removed on exit.
+# Shared by the service test scripts (sourced after setting $build, the build folder): the
+# programs under test, checks that count failures, stopping processes, reading numbers out of
+# summaries. Background processes are killed and $work removed on exit.
+camera=$build/services/evldt-camera/evldt-camera
+lines=$build/services/evldt-lines/evldt-lines
+viz=$build/services/evldt-viz/evldt-viz
+offline=$build/tools/evldt-offline/evldt-offline
+eval_tool=$build/tools/evldt-eval/evldt-eval
+junk=$build/tests/lcm_publish_junk
+probe=$build/tests/lcm_lines_probe
+relay=$build/tests/lcm_lossy_relay
 work=$(mktemp -d)
 pids=()
 failures=0
