@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <opencv2/highgui.hpp>
 #include <optional>
 #include <spdlog/spdlog.h>
@@ -38,6 +39,10 @@ int main(int argc, char** argv) {
   return run_main(app, argc, argv, [&] {
     if (headless && video.empty() && png_dir.empty()) {
       throw std::invalid_argument("--headless draws nothing visible: add --video FILE and/or --png-dir DIR");
+    }
+    // OpenCV's window toolkit aborts the process when it finds no display: say so first instead.
+    if (!headless && !std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY")) {
+      throw std::invalid_argument("no display (DISPLAY is not set): run with --headless and --video and/or --png-dir");
     }
     options.camera = lcm_options.camera();
     const auto& stop = stop_on_signals();

@@ -74,6 +74,11 @@ replay_f=$(f_at_1_percent "$work/replay.json")
 echo "F@1%: replayed $replay_f"
 check "replayed F@1% within 0.06 of the live run" close_to "$replay_f" "$live_f" 0.06
 
+# --- a window without a display is a clear error, not OpenCV's abort -------------------------
+env -u DISPLAY -u WAYLAND_DISPLAY "$viz" --lcm-url "$url" >/dev/null 2>"$work/nodisplay.err"
+check "evldt-viz without a display exits 1 with a message" test $? -eq 1
+check "... that says to run headless" grep -q "no display.*--headless" "$work/nodisplay.err"
+
 # --- lcm-spy decodes every message type -----------------------------------------------------
 jar=$build/lcmtypes/evldt_lcmtypes.jar
 if [[ -f $jar ]] && command -v javac >/dev/null; then
