@@ -45,13 +45,14 @@ int main(int argc, char** argv) {
     const LinesNodeTotals t = node.totals();
     std::printf(
         "evldt-lines summary\n"
-        "  batches   %llu received, %llu lost (sequence gaps), %llu late, %llu invalid messages, %llu camera restarts\n"
+        "  batches   %llu received, %llu lost (sequence gaps), %llu late (%llu resyncs), %llu invalid messages, %llu camera restarts\n"
         "  events    %llu stored, %llu dropped (%llu off sensor, %llu back in time), %llu clock resets\n"
         "  loops     %llu detection rounds, %llu tracking rounds\n"
         "  output    %llu lines created, %llu segment lists published\n"
         "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches)\n",
         static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),
-        static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.invalid_messages),
+        static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.sequence.resyncs),
+        static_cast<unsigned long long>(t.receiver.invalid_messages),
         static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.events_stored),
         static_cast<unsigned long long>(t.receiver.drops.total()), static_cast<unsigned long long>(t.receiver.drops.off_sensor),
         static_cast<unsigned long long>(t.receiver.drops.time_backwards),

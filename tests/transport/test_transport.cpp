@@ -337,6 +337,31 @@ TEST(SequenceTracker, CountsGapsLateAndRestarts) {
   EXPECT_EQ(counts.restarts, 1u);
 }
 
+TEST(SequenceTracker, OneForgedMessageAheadCannotSilenceTheStream) {
+  SequenceTracker tracker;
+  EXPECT_TRUE(tracker.observe(1, 0));
+  EXPECT_TRUE(tracker.observe(INT64_MAX, INT64_MAX));  // forged: the newest epoch there can be
+  std::int64_t seq = 1;
+  for (; seq < static_cast<std::int64_t>(kSequenceResyncRun); ++seq) EXPECT_FALSE(tracker.observe(1, seq));
+  EXPECT_TRUE(tracker.observe(1, seq));  // the real camera's stream is followed again
+  EXPECT_TRUE(tracker.observe(1, seq + 1));
+  const SequenceCounts& counts = tracker.counts();
+  EXPECT_EQ(counts.late, kSequenceResyncRun - 1);
+  EXPECT_EQ(counts.resyncs, 1u);
+  EXPECT_EQ(counts.restarts, 2u);  // the forged epoch, then the resync
+  EXPECT_EQ(counts.lost, 0u);
+}
+
+TEST(SequenceTracker, TwoPublishersInterleavedFollowTheNewerWithoutResync) {
+  SequenceTracker tracker;
+  for (std::int64_t seq = 0; seq < 300; ++seq) {
+    tracker.observe(1, seq);  // a camera started earlier with the same name
+    EXPECT_TRUE(tracker.observe(2, seq));
+  }
+  EXPECT_EQ(tracker.counts().resyncs, 0u);
+  EXPECT_EQ(tracker.counts().late, 299u);
+}
+
 TEST(SequenceTracker, ForgedHugeSequenceDoesNotOverflow) {
   SequenceTracker tracker;
   EXPECT_TRUE(tracker.observe(1, INT64_MIN));

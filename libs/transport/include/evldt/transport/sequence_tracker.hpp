@@ -1,6 +1,8 @@
 #pragma once
 // Loss accounting for a stream of numbered messages (DESIGN 7): a gap in the sequence is lost
-// messages; a newer publisher epoch (a restarted camera) starts the count afresh.
+// messages; a newer publisher epoch (a restarted camera) starts the count afresh. A long run of
+// messages all behind the newest (epoch, sequence) means that newest was forged or stale: the
+// tracker then follows the stream that keeps arriving, so one bad message cannot silence a camera.
 
 #include <cstdint>
 
@@ -10,8 +12,12 @@ struct SequenceCounts {
   std::uint64_t received = 0;
   std::uint64_t lost = 0;          ///< sequence numbers skipped
   std::uint64_t late = 0;          ///< duplicates, out of order, or from an older epoch (not used)
-  std::uint64_t restarts = 0;      ///< publisher epochs seen after the first
+  std::uint64_t restarts = 0;      ///< publisher epochs seen after the first, resyncs included
+  std::uint64_t resyncs = 0;       ///< runs of late messages after which their stream was followed
 };
+
+/// Consecutive late messages after which the tracker follows their stream: 0.1 s of 1 kHz batches.
+inline constexpr std::uint64_t kSequenceResyncRun = 100;
 
 class SequenceTracker {
  public:
@@ -24,6 +30,7 @@ class SequenceTracker {
   bool started_ = false;
   std::int64_t epoch_ = 0;
   std::int64_t last_ = 0;  ///< newest sequence number accepted in this epoch
+  std::uint64_t late_run_ = 0;
   SequenceCounts counts_;
 };
 
