@@ -113,6 +113,21 @@ TEST(Pipeline, RoundsRunOnEventTimeAndLongGapsAreSkipped) {
   EXPECT_GT(pipeline.counters().skipped_rounds, 3000000u);
 }
 
+TEST(Pipeline, AfterTheClockWentBackRoundsRunOnTheNewClock) {
+  PipelineConfig config = default_config_for(kSensor);
+  DeterministicPipeline pipeline(config);
+  EventBatch before;
+  before.push_back(50'000'000, 50, 50, 1);
+  before.push_back(50'100'000, 50, 50, 1);
+  pipeline.process(before);
+  const std::uint64_t rounds_before = pipeline.counters().track_rounds;
+  // The camera clock began again (the validator followed it): the sweep arrives at t = 0..0.3 s.
+  pipeline.process(vertical_sweep());
+  EXPECT_EQ(pipeline.counters().clock_restarts, 1u);
+  EXPECT_GE(pipeline.counters().track_rounds - rounds_before, 140u);  // 0.3 s of 2 ms rounds
+  EXPECT_FALSE(pipeline.lines().lines().empty());
+}
+
 TEST(RealtimeEngine, FindsTheSweepingEdgeOnItsOwnThreads) {
   const PipelineConfig config = default_config_for(kSensor);
   RealtimeEngine engine(config);

@@ -44,8 +44,10 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
                events_read, counters.events, drops.total(), drops.off_sensor, drops.time_backwards, drops.clock_resets);
   std::fprintf(out, "  event time       %.3f s (%.2f Mev/s)\n", event_seconds, event_seconds > 0 ? mev / event_seconds : 0.0);
   std::fprintf(out, "  wall time        %.3f s (%.2f Mev/s processed)\n", wall_seconds, wall_seconds > 0 ? mev / wall_seconds : 0.0);
-  std::fprintf(out, "  rounds           %" PRIu64 " tracking, %" PRIu64 " detection, %" PRIu64 " skipped over gaps\n",
-               counters.track_rounds, counters.detect_rounds, counters.skipped_rounds);
+  std::fprintf(out,
+               "  rounds           %" PRIu64 " tracking, %" PRIu64 " detection, %" PRIu64 " skipped over gaps, %" PRIu64
+               " schedule restarts (clock went back)\n",
+               counters.track_rounds, counters.detect_rounds, counters.skipped_rounds, counters.clock_restarts);
   std::fprintf(out, "  lines            %" PRIu64 " created, %" PRIu64 " alive at the end\n", lines_created, lines_alive);
   std::fprintf(out, "  released         ");
   for (int r = 0; r < kReleaseReasonCount; ++r) {
@@ -69,6 +71,7 @@ void RunSummary::write_json(const std::filesystem::path& path) const {
   out << "  \"event_seconds\": " << event_seconds << ",\n  \"wall_seconds\": " << wall_seconds << ",\n";
   out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds << ",\n";
   out << "  \"skipped_rounds\": " << counters.skipped_rounds << ",\n";
+  out << "  \"clock_restarts\": " << counters.clock_restarts << ",\n";
   out << "  \"lines_created\": " << lines_created << ",\n  \"lines_alive\": " << lines_alive << ",\n  \"released\": {";
   for (int r = 0; r < kReleaseReasonCount; ++r) {
     out << (r ? ", " : "") << '"' << reason_name(static_cast<ReleaseReason>(r)) << "\": " << released[r];

@@ -40,7 +40,12 @@ void DeterministicPipeline::update_next_due() {
 void DeterministicPipeline::process(const EventBatch& batch) {
   const std::size_t n = batch.size();
   if (n == 0) return;
-  if (!started_) start(batch.t[0]);
+  if (!started_) {
+    start(batch.t[0]);
+  } else if (batch.t[0] < next_due_ - kClockStepBackUs) {
+    ++counters_.clock_restarts;
+    start(batch.t[0]);
+  }
   const Timestamp* ts = batch.t.data();
   const std::uint16_t* xs = batch.x.data();
   const std::uint16_t* ys = batch.y.data();

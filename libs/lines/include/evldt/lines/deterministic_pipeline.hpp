@@ -15,7 +15,12 @@ struct PipelineCounters {
   std::uint64_t track_rounds = 0;
   std::uint64_t detect_rounds = 0;
   std::uint64_t skipped_rounds = 0;  ///< rounds not run across long gaps in event time
+  std::uint64_t clock_restarts = 0;  ///< schedules begun again because event time went back
 };
+
+/// A batch starting this far before the next due round means the clock went back (an EventValidator
+/// only lets that through when it follows a clock reset): the round schedule begins again there.
+inline constexpr Timestamp kClockStepBackUs = 1'000'000;
 
 class DeterministicPipeline {
  public:
@@ -28,7 +33,8 @@ class DeterministicPipeline {
   void set_output(Timestamp period_us, StepCallback on_step);
 
   /// Feeds on-sensor events in time order (an EventValidator upstream guarantees both). A round due
-  /// at time T sees exactly the events with t < T.
+  /// at time T sees exactly the events with t < T. After a clock reset upstream, the schedule
+  /// begins again at the first batch more than kClockStepBackUs behind it.
   void process(const EventBatch& batch);
 
   [[nodiscard]] const LineMap& lines() const { return lines_; }
