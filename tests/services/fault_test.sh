@@ -18,21 +18,17 @@ now_us() { date +%s%6N; }
 # --- 1. kill -9 and restart ---------------------------------------------------------------------
 "$probe" "$url" cam0 8 >"$work/probe1.out" &
 probe_pid=$!
-pids+=("$probe_pid")
 "$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines1.out" 2>"$work/lines1.err" &
 lines1_pid=$!
-pids+=("$lines1_pid")
 sleep 0.5
 "$camera" --lcm-url "$url" --scene boxes-6dof --duration-s 5 -q >"$work/camera1.out" 2>"$work/camera1.err" &
 camera_pid=$!
-pids+=("$camera_pid")
 sleep 2
 kill -9 "$lines1_pid"
 sleep 0.2
 restarted_at=$(now_us)
 "$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines2.out" 2>"$work/lines2.err" &
 lines2_pid=$!
-pids+=("$lines2_pid")
 wait "$camera_pid"
 check "camera published the whole scene through the restart" test $? -eq 0
 cat "$work/camera1.out"
@@ -59,23 +55,17 @@ check "the restarted process lost no batch (it begins counting at its first)" gr
 duration_s=4
 lcm-logger --lcm-url="$url" -f -q --channel='LINES_CAM0' "$work/lossy.lcm" &
 logger_pid=$!
-pids+=("$logger_pid")
 "$relay" "$url" EVENTS_RAW EVENTS_CAM0 20 $((duration_s + 2)) >"$work/relay.out" &
 relay_pid=$!
-pids+=("$relay_pid")
 "$probe" "$url" cam0 $((duration_s + 2)) >"$work/probe2.out" &
 probe_pid=$!
-pids+=("$probe_pid")
 "$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines3.out" 2>"$work/lines3.err" &
 lines_pid=$!
-pids+=("$lines_pid")
 "$viz" --lcm-url "$url" --headless --png-dir "$work/png" --png-period-s 0.5 >"$work/viz.out" 2>"$work/viz.err" &
 viz_pid=$!
-pids+=("$viz_pid")
 sleep 0.5
 "$camera" --lcm-url "$url" --camera raw --scene boxes-6dof --duration-s "$duration_s" -q >"$work/camera2.out" 2>"$work/camera2.err" &
 camera_pid=$!
-pids+=("$camera_pid")
 sleep 1
 kill -STOP "$viz_pid"
 stall_from=$(now_us)

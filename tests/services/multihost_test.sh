@@ -56,16 +56,12 @@ check "ttl=1 traffic of host 2 reaches host 3 across the bridge" test "$(heard_f
 
 "${h3[@]}" "$probe" "$url" cam0 5 >"$work/probe.out" &
 probe_pid=$!
-pids+=("$probe_pid")
 "${h3[@]}" lcm-logger --lcm-url="$url" -f -q "$work/far.lcm" &
 logger_pid=$!
-pids+=("$logger_pid")
 "${h3[@]}" "$viz" --lcm-url "$url" --headless --png-dir "$work/png" --png-period-s 0.5 >"$work/viz.out" 2>"$work/viz.err" &
 viz_pid=$!
-pids+=("$viz_pid")
 "${h2[@]}" "$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines.out" 2>"$work/lines.err" &
 lines_pid=$!
-pids+=("$lines_pid")
 sleep 0.7
 "${h1[@]}" "$camera" --lcm-url "$url" --scene boxes-6dof --duration-s 2 -q >"$work/camera.out" 2>"$work/camera.err"
 check "camera on host 1 exits 0" test $? -eq 0

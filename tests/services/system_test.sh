@@ -15,14 +15,11 @@ scene=(--scene boxes-6dof --duration-s 1.5)
 # --- live run ---------------------------------------------------------------------------------
 lcm-logger --lcm-url="$url" -f -q "$work/live.lcm" &
 logger_pid=$!
-pids+=("$logger_pid")
 "$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines.out" 2>"$work/lines.err" &
 lines_pid=$!
-pids+=("$lines_pid")
 "$viz" --lcm-url "$url" --headless --video "$work/viz.mp4" --png-dir "$work/png" --png-period-s 0.5 --fps 20 \
   >"$work/viz.out" 2>"$work/viz.err" &
 viz_pid=$!
-pids+=("$viz_pid")
 sleep 1
 "$junk" "$url" EVENTS_CAM0 8
 "$camera" --lcm-url "$url" "${scene[@]}" -q >"$work/camera.out" 2>"$work/camera.err"
@@ -58,10 +55,8 @@ check "live F@1% >= 0.75" close_to "$live_f" 0.875 0.125
 # --- replay: lcm-logplayer feeds the recorded events to a fresh lines service ------------------
 lcm-logger --lcm-url="$replay_url" -f -q --channel='LINES_.*' "$work/replay.lcm" &
 replay_logger_pid=$!
-pids+=("$replay_logger_pid")
 "$lines" --lcm-url "$replay_url" --log-period-s 0 >"$work/replay_lines.out" 2>"$work/replay_lines.err" &
 replay_lines_pid=$!
-pids+=("$replay_lines_pid")
 sleep 1
 lcm-logplayer --lcm-url="$replay_url" --regexp='EVENTS_.*' "$work/live.lcm"
 sleep 0.5

@@ -1,6 +1,6 @@
 # Shared by the service test scripts (sourced after setting $build, the build folder): the
 # programs under test, checks that count failures, stopping processes, reading numbers out of
-# summaries. Background processes are killed and $work removed on exit.
+# summaries. Background jobs still running are killed and $work removed on exit.
 camera=$build/services/evldt-camera/evldt-camera
 lines=$build/services/evldt-lines/evldt-lines
 viz=$build/services/evldt-viz/evldt-viz
@@ -10,11 +10,10 @@ junk=$build/tests/lcm_publish_junk
 probe=$build/tests/lcm_lines_probe
 relay=$build/tests/lcm_lossy_relay
 work=$(mktemp -d)
-pids=()
 failures=0
 cleanup_hooks=()
 cleanup() {
-  for pid in "${pids[@]}"; do kill -9 "$pid" 2>/dev/null; done
+  for pid in $(jobs -p); do kill -9 "$pid" 2>/dev/null; done
   for hook in "${cleanup_hooks[@]}"; do eval "$hook"; done
   rm -rf "$work"
 }
