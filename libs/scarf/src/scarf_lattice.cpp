@@ -37,7 +37,7 @@ LatticeGeometry LatticeGeometry::make(SensorSize sensor, int block_size, double 
   g.blocks_x = sensor.width / block_size - 1;
   g.blocks_y = sensor.height / block_size - 1;
   const double capacity = std::floor(alpha * block_size * block_size / 2.0);
-  if (g.blocks_x < 1 || g.blocks_y < 1) {
+  if (!fits(sensor, block_size)) {
     throw std::invalid_argument("block size " + std::to_string(block_size) + " leaves no block on a " +
                                 std::to_string(sensor.width) + "x" + std::to_string(sensor.height) + " sensor");
   }
