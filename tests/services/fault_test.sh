@@ -55,7 +55,7 @@ check "the restarted process lost no batch (it begins counting at its first)" gr
 duration_s=4
 lcm-logger --lcm-url="$url" -f -q --channel='LINES_CAM0' "$work/lossy.lcm" &
 logger_pid=$!
-"$relay" "$url" EVENTS_RAW EVENTS_CAM0 20 $((duration_s + 2)) >"$work/relay.out" &
+"$relay" "$url" EVENTS_RAW EVENTS_CAM0 20 2 >"$work/relay.out" &
 relay_pid=$!
 "$probe" "$url" cam0 $((duration_s + 2)) >"$work/probe2.out" &
 probe_pid=$!
@@ -72,11 +72,11 @@ stall_from=$(now_us)
 sleep 2
 stall_to=$(now_us)
 kill -CONT "$viz_pid"
-wait "$camera_pid"
+wait "$camera_pid" "$relay_pid"  # the relay has forwarded the whole stream
 sleep 0.3
 stops_within_a_second "$lines_pid"
 stops_within_a_second "$viz_pid"
-wait "$relay_pid" "$probe_pid"
+wait "$probe_pid"
 stops_within_a_second "$logger_pid" INT
 cat "$work/relay.out" "$work/lines3.out" "$work/viz.out"
 
