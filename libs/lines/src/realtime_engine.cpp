@@ -29,11 +29,11 @@ void RealtimeEngine::start() {
     stopping_ = false;
   }
   detect_thread_ = std::thread([this] {
-    loop(detect_view_, detect_rounds_, config_.schedule.detect_period_us,
+    loop(detect_view_, detect_wake_at_us_, detect_rounds_, config_.schedule.detect_period_us,
          [this](const ScarfLattice& view, Timestamp now) { detector_.detect(view, lines_, now); });
   });
   track_thread_ = std::thread([this] {
-    loop(track_view_, track_rounds_, config_.schedule.track_period_us,
+    loop(track_view_, track_wake_at_us_, track_rounds_, config_.schedule.track_period_us,
          [this](const ScarfLattice& view, Timestamp now) { tracker_.track(view, lines_, now); });
   });
 }
@@ -52,18 +52,21 @@ void RealtimeEngine::process(const EventBatch& batch) {
   const std::size_t n = batch.size();
   for (std::size_t begin = 0; begin < n; begin += kInsertChunk) {
     const std::size_t end = std::min(n, begin + kInsertChunk);
+    bool wake = false;
     {
       std::lock_guard lock(lattice_mutex_);
       lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin));
       events_stored_ += end - begin;
       latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
+      wake = latest_event_us_ >= std::min(detect_wake_at_us_, track_wake_at_us_);
     }
-    lattice_changed_.notify_all();
+    if (wake) lattice_changed_.notify_all();
   }
 }
 
 template <typename Round>
-void RealtimeEngine::loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round) {
+void RealtimeEngine::loop(ScarfLattice& view, Timestamp& wake_at_us, std::atomic<std::uint64_t>& rounds,
+                          Timestamp period_us, Round round) {
   std::uint64_t seen = 0;
   Timestamp next_due = std::numeric_limits<Timestamp>::min();
   const auto wall_period = std::chrono::microseconds(period_us);
@@ -75,11 +78,14 @@ void RealtimeEngine::loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds
       // deterministic schedule; more rounds would repeat work the storage thread needs the CPU
       // for). A round on an unchanged lattice would repeat the last one.
       const auto due = [&] { return stopping_ || (events_stored_ != seen && latest_event_us_ >= next_due); };
+      wake_at_us = next_due;
       if (!lattice_changed_.wait_for(lock, wall_period, due)) {
         // A period of wall time without a period of event time (a sparse or ending stream): run
         // on whatever is new, so the last events are never left waiting.
+        wake_at_us = std::numeric_limits<Timestamp>::min();
         lattice_changed_.wait(lock, [&] { return stopping_ || events_stored_ != seen; });
       }
+      wake_at_us = std::numeric_limits<Timestamp>::max();  // busy with a round: nothing to wake
       if (stopping_) return;
       view.copy_state_from(lattice_);
       seen = events_stored_;

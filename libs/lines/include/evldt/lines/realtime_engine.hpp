@@ -47,7 +47,8 @@ class RealtimeEngine {
 
  private:
   template <typename Round>
-  void loop(ScarfLattice& view, std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round);
+  void loop(ScarfLattice& view, Timestamp& wake_at_us, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
+            Round round);
 
   PipelineConfig config_;
   ScarfLattice lattice_;                      // guarded by lattice_mutex_
@@ -57,6 +58,9 @@ class RealtimeEngine {
   std::uint64_t events_stored_ = 0;           // guarded by lattice_mutex_
   Timestamp latest_event_us_ = 0;             // guarded by lattice_mutex_
   bool stopping_ = false;                     // guarded by lattice_mutex_
+  // Event time at which each loop, while it waits, wants to be woken (guarded by lattice_mutex_):
+  // storage wakes the loops only when a round may be due, not at every batch.
+  Timestamp detect_wake_at_us_ = 0, track_wake_at_us_ = 0;
 
   mutable std::mutex lines_mutex_;
   LineMap lines_;                             // guarded by lines_mutex_
