@@ -153,15 +153,36 @@ TEST(ScarfLattice, IncrementalCopyFollowsEveryChange) {
   expect_same_rings(source, view);
 }
 
-TEST(ScarfLattice, VersionsChangeWithEveryWriteAndClear) {
+TEST(ScarfLattice, AVersionChangesWhenItsBlockChangesAndOnlyThen) {
   ScarfLattice lattice(kSensor, 8, 1.0);
   const int block = lattice.geometry().index(3, 2);  // holds pixel (30, 22) actively
+  const int elsewhere = lattice.geometry().index(0, 0);
   const std::uint64_t before = lattice.version(block);
+  const std::uint64_t elsewhere_before = lattice.version(elsewhere);
   lattice.insert(30, 22);
-  EXPECT_EQ(lattice.version(block), before + 1);
+  const std::uint64_t once = lattice.version(block);
+  EXPECT_NE(once, before);
+  EXPECT_EQ(lattice.version(elsewhere), elsewhere_before);
+  lattice.insert(30, 22);  // the same event again still advances the ring
+  EXPECT_NE(lattice.version(block), once);
+  const std::uint64_t twice = lattice.version(block);
   lattice.clear();
-  EXPECT_EQ(lattice.version(block), before + 2);
-  EXPECT_EQ(lattice.version(lattice.geometry().index(0, 0)), 1u);  // untouched before the clear
+  EXPECT_NE(lattice.version(block), twice);
+  EXPECT_NE(lattice.version(elsewhere), elsewhere_before);  // a clear changes every block
+}
+
+// Versions compare only under one versions_of(): a copy changed after the copy must not claim the
+// numbering it had before, nor that of its source.
+TEST(ScarfLattice, ACopyChangedAfterwardsNumbersItsVersionsApart) {
+  ScarfLattice source(kSensor, 8, 1.0);
+  ScarfLattice copy(kSensor, 8, 1.0);
+  copy.insert(30, 22);
+  const std::uint64_t copy_numbering = copy.versions_of();
+  copy.copy_state_from(source);
+  EXPECT_EQ(copy.versions_of(), source.versions_of());
+  copy.insert(30, 22);
+  EXPECT_NE(copy.versions_of(), copy_numbering);
+  EXPECT_NE(copy.versions_of(), source.versions_of());
 }
 
 // An edge crossing the sensor at speed v leaves (per block it has passed) the same active entries

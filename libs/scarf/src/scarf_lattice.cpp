@@ -58,13 +58,8 @@ int LatticeGeometry::block_at(float x, float y) const {
   return index(i, j);
 }
 
-namespace {
-
-// For one axis of `length` pixels: the home block and the side block of every pixel (see header).
-void build_axis_tables(int length, int block_size, int blocks, int stride, std::vector<std::int32_t>& home,
-                       std::vector<std::int32_t>& side) {
-  home.assign(static_cast<std::size_t>(length), -1);
-  side.assign(static_cast<std::size_t>(length), -1);
+std::vector<ScarfLattice::AxisBlocks> ScarfLattice::axis_blocks(int length, int block_size, int blocks, int stride) {
+  std::vector<AxisBlocks> table(static_cast<std::size_t>(length));
   const int half = block_size / 2;
   for (int p = 0; p < length; ++p) {
     const int shifted = p - half;
@@ -72,29 +67,28 @@ void build_axis_tables(int length, int block_size, int blocks, int stride, std::
     const int cell = shifted >= 0 ? shifted / block_size : -1;
     const int offset = shifted - cell * block_size;
     const int neighbour = offset < half ? cell - 1 : cell + 1;
-    if (cell >= 0 && cell < blocks) home[p] = cell * stride;
-    if (neighbour >= 0 && neighbour < blocks) side[p] = neighbour * stride;
+    if (cell >= 0 && cell < blocks) table[p].home = cell * stride;
+    if (neighbour >= 0 && neighbour < blocks) table[p].side = neighbour * stride;
   }
+  return table;
 }
-
-}  // namespace
 
 ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool keep_surface)
     : geometry_(LatticeGeometry::make(sensor, block_size, alpha)), id_(next_lattice_id()) {
-  build_axis_tables(sensor.width, block_size, geometry_.blocks_x, 1, column_home_, column_side_);
-  build_axis_tables(sensor.height, block_size, geometry_.blocks_y, geometry_.blocks_x, row_home_, row_side_);
+  columns_ = axis_blocks(sensor.width, block_size, geometry_.blocks_x, 1);
+  rows_ = axis_blocks(sensor.height, block_size, geometry_.blocks_y, geometry_.blocks_x);
   blocks_.resize(static_cast<std::size_t>(geometry_.block_count()));
   entries_.resize(static_cast<std::size_t>(geometry_.block_count()) * geometry_.capacity);
   if (keep_surface) surface_.assign(static_cast<std::size_t>(sensor.width) * sensor.height, 0);
 }
 
 void ScarfLattice::insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys) {
-  copied_from_ = 0;
+  const Rings rings = begin_change();
   const std::size_t n = std::min(xs.size(), ys.size());
-  if (surface_.empty()) {
-    for (std::size_t i = 0; i < n; ++i) insert_event<false>(xs[i], ys[i]);
+  if (rings.surface == nullptr) {
+    for (std::size_t i = 0; i < n; ++i) insert_event<false>(rings, xs[i], ys[i]);
   } else {
-    for (std::size_t i = 0; i < n; ++i) insert_event<true>(xs[i], ys[i]);
+    for (std::size_t i = 0; i < n; ++i) insert_event<true>(rings, xs[i], ys[i]);
   }
 }
 
@@ -124,17 +118,20 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
     begin = end;
   }
   copied_from_ = other.versions_of();
+  id_ = next_lattice_id();
+  change_clock_ = std::max(change_clock_, other.change_clock_);
 }
 
 std::size_t ScarfLattice::memory_bytes() const {
-  const std::size_t tables = column_home_.size() + column_side_.size() + row_home_.size() + row_side_.size();
-  return entries_.size() * sizeof(LatticeEntry) + blocks_.size() * sizeof(BlockState) + tables * sizeof(std::int32_t) +
+  return entries_.size() * sizeof(LatticeEntry) + blocks_.size() * sizeof(BlockState) +
+         (columns_.size() + rows_.size()) * sizeof(AxisBlocks) +
          surface_.size() * sizeof(std::uint16_t);
 }
 
 void ScarfLattice::clear() {
   copied_from_ = 0;
-  for (BlockState& state : blocks_) state = BlockState{.version = state.version + 1};
+  ++change_clock_;
+  for (BlockState& state : blocks_) state = BlockState{.version = change_clock_};
   std::fill(surface_.begin(), surface_.end(), std::uint16_t{0});
 }
 

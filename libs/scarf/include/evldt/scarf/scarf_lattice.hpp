@@ -71,11 +71,11 @@ class ScarfLattice {
 
   /// Stores one on-sensor event (the caller validates coordinates). O(1), never allocates.
   void insert(std::uint16_t x, std::uint16_t y) {
-    copied_from_ = 0;
-    if (surface_.empty()) {
-      insert_event<false>(x, y);
+    const Rings rings = begin_change();
+    if (rings.surface == nullptr) {
+      insert_event<false>(rings, x, y);
     } else {
-      insert_event<true>(x, y);
+      insert_event<true>(rings, x, y);
     }
   }
   /// Stores the on-sensor events (xs[i], ys[i]) in order; the spans have the same length.
@@ -88,8 +88,9 @@ class ScarfLattice {
     return {entries_.data() + static_cast<std::size_t>(block) * geometry_.capacity, blocks_[block].filled};
   }
   [[nodiscard]] int active_count(int block) const { return blocks_[block].active; }
-  /// Changes the block has seen (events written, clears): equal values mean identical contents, so
-  /// a reader can skip a block it has already seen in this state.
+  /// When the block last changed (events written, clear), on a clock that advances once per insert
+  /// call: equal values mean identical contents, so a reader can skip a block it has already seen
+  /// in this state.
   [[nodiscard]] std::uint64_t version(int block) const { return blocks_[block].version; }
   /// Which lattice the versions count the changes of: this one's id, or that of the lattice this is
   /// an unmodified copy of (copy_state_from). Versions compare only under the same value.
@@ -111,53 +112,78 @@ class ScarfLattice {
     std::uint16_t head = 0;    ///< next slot to overwrite
     std::uint16_t filled = 0;  ///< slots in use (reaches N and stays)
     std::uint16_t active = 0;  ///< ACTIVE entries among them
-    std::uint64_t version = 0; ///< +1 per write or clear, never repeats
+    std::uint64_t version = 0; ///< the change clock when the block last changed
+  };
+  /// Per pixel column (row): the block column (row) whose active region holds it, and the one on
+  /// the side of the half it lies in, whose extended region also holds it; -1 where there is none.
+  /// Rows are pre-multiplied by blocks_x so a block index is a single add.
+  struct AxisBlocks {
+    std::int32_t home = -1;
+    std::int32_t side = -1;
+  };
+  /// The table of one axis of `length` pixels, `blocks` blocks, block indices scaled by `stride`.
+  static std::vector<AxisBlocks> axis_blocks(int length, int block_size, int blocks, int stride);
+  /// What the insert loop works with, held in locals: stores into the rings could otherwise alias
+  /// members the compiler would then reload at every event.
+  struct Rings {
+    const AxisBlocks* columns;
+    const AxisBlocks* rows;
+    BlockState* blocks;
+    LatticeEntry* entries;
+    std::uint16_t* surface;  ///< null without keep_surface
+    std::size_t width;
+    std::uint16_t capacity;
+    std::uint64_t version;
   };
 
+  Rings begin_change() {
+    copied_from_ = 0;
+    ++change_clock_;
+    return {columns_.data(), rows_.data(), blocks_.data(), entries_.data(), surface_.empty() ? nullptr : surface_.data(),
+            static_cast<std::size_t>(geometry_.sensor.width), static_cast<std::uint16_t>(geometry_.capacity), change_clock_};
+  }
+
   template <bool kSurface>
-  void insert_event(std::uint16_t x, std::uint16_t y) {
-    const std::int32_t home_i = column_home_[x];
-    const std::int32_t home_j = row_home_[y];
-    const std::int32_t side_i = column_side_[x];
-    const std::int32_t side_j = row_side_[y];
-    if (home_i >= 0 && home_j >= 0) push<kSurface, true>(home_j + home_i, x, y);
-    if (side_i >= 0 && home_j >= 0) push<kSurface, false>(home_j + side_i, x, y);
-    if (home_i >= 0 && side_j >= 0) push<kSurface, false>(side_j + home_i, x, y);
-    if (side_i >= 0 && side_j >= 0) push<kSurface, false>(side_j + side_i, x, y);
+  static void insert_event(const Rings& rings, std::uint16_t x, std::uint16_t y) {
+    const AxisBlocks column = rings.columns[x];
+    const AxisBlocks row = rings.rows[y];
+    if ((column.home | row.home) >= 0) push<kSurface, true>(rings, row.home + column.home, x, y);
+    if ((column.side | row.home) >= 0) push<kSurface, false>(rings, row.home + column.side, x, y);
+    if ((column.home | row.side) >= 0) push<kSurface, false>(rings, row.side + column.home, x, y);
+    if ((column.side | row.side) >= 0) push<kSurface, false>(rings, row.side + column.side, x, y);
   }
 
   // Branch-free bookkeeping: whether the overwritten entry was active is data (about a third of
   // entries are), and a branch on it mispredicts.
   template <bool kSurface, bool kActive>
-  void push(std::int32_t block, std::uint16_t x, std::uint16_t y) {
-    BlockState state = blocks_[block];  // one 16-byte load and store instead of four read-modify-writes
-    LatticeEntry& slot = entries_[static_cast<std::size_t>(block) * geometry_.capacity + state.head];
-    const auto full = static_cast<std::uint16_t>(state.filled == geometry_.capacity);
+  static void push(const Rings& rings, std::int32_t block, std::uint16_t x, std::uint16_t y) {
+    BlockState state = rings.blocks[block];
+    LatticeEntry& slot = rings.entries[static_cast<std::size_t>(block) * rings.capacity + state.head];
+    const auto full = static_cast<std::uint16_t>(state.filled == rings.capacity);
     const auto evicted_active = static_cast<std::uint16_t>(full & (slot.y_and_flag >> 15));
     if constexpr (kSurface) {
-      if (evicted_active) --surface_[static_cast<std::size_t>(slot.y()) * geometry_.sensor.width + slot.x];
-      if (kActive) ++surface_[static_cast<std::size_t>(y) * geometry_.sensor.width + x];
+      if (evicted_active) --rings.surface[static_cast<std::size_t>(slot.y()) * rings.width + slot.x];
+      if (kActive) ++rings.surface[static_cast<std::size_t>(y) * rings.width + x];
     }
     state.filled = static_cast<std::uint16_t>(state.filled + 1 - full);
     state.active = static_cast<std::uint16_t>(state.active + (kActive ? 1 : 0) - evicted_active);
     slot = {x, static_cast<std::uint16_t>(kActive ? y | LatticeEntry::kActiveBit : y)};
     const auto next = static_cast<std::uint16_t>(state.head + 1);
-    state.head = next == geometry_.capacity ? std::uint16_t{0} : next;
-    ++state.version;
-    blocks_[block] = state;
+    state.head = next == rings.capacity ? std::uint16_t{0} : next;
+    state.version = rings.version;
+    rings.blocks[block] = state;
   }
 
   LatticeGeometry geometry_;
-  // Per pixel column / row: the block column (row) whose active region holds it, and the one on
-  // the side of the half it lies in, whose extended region also holds it; -1 where there is none.
-  // Row tables are pre-multiplied by blocks_x so a block index is a single add.
-  std::vector<std::int32_t> column_home_, column_side_, row_home_, row_side_;
+  std::vector<AxisBlocks> columns_, rows_;
   std::vector<BlockState> blocks_;
   std::vector<LatticeEntry> entries_;
-  // Versions are only comparable with the lattice they were copied from: a process-unique id, and
+  // Versions are only comparable with the lattice they were copied from: a process-unique id (a
+  // fresh one at every copy, so changes after a copy are numbered apart from those before), and
   // the id of the lattice this one is an unmodified copy of (0: none).
   std::uint64_t id_;
   std::uint64_t copied_from_ = 0;
+  std::uint64_t change_clock_ = 0;  ///< +1 per insert call or clear; never below a version held
   std::vector<std::uint16_t> surface_;
 };
 
