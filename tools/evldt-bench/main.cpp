@@ -1,6 +1,7 @@
-// evldt-bench: speed and memory of the core at every supported sensor size, on one core. For each
-// size a built-in scene is simulated (the first --window-ms), and each figure is the median of
-// --repeats timed repeats, each repeat long enough (--min-time-ms) for the clock not to matter.
+// evldt-bench: speed and memory of the core, and of receiving events off the wire, at every supported
+// sensor size, on one core. For each size a built-in scene is simulated (the first --window-ms), and
+// each figure is the median of --repeats timed repeats, each repeat long enough (--min-time-ms) for
+// the clock not to matter.
 // Every size runs in a child process of its own, so its peak RSS is its own.
 
 #include <CLI/CLI.hpp>
@@ -20,6 +21,8 @@
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
+#include "evldt/transport/event_batch_receiver.hpp"
+#include "evldt/transport/messages.hpp"
 
 namespace {
 
@@ -49,6 +52,7 @@ struct Figures {
   double scene_rate_mev_s = 0;  ///< their rate in the scene
   Timing storage;               ///< per event
   Timing storage_aos;           ///< per event, from an array of Event structs
+  Timing receive;               ///< per event: an LCM event batch decoded, checked and validated
   Timing detect;                ///< per pass, every block free
   double active_points = 0;     ///< active entries in the lattice the passes see
   double lines_created = 0;
@@ -113,6 +117,32 @@ EventBatch simulate(const Scene& scene, Timestamp window_us) {
   return events;
 }
 
+/// Seconds to receive the events as the camera publishes them (messages of up to 7000 events, one
+/// datagram each): what evldt-lines' receive thread does before storage.
+Timing time_receive(const BenchSettings& settings, SensorSize sensor, const EventBatch& events) {
+  constexpr std::size_t kEventsPerMessage = 7000;
+  event_batch_t header;
+  header.epoch = 1;
+  header.source = "bench";
+  header.width = static_cast<std::int16_t>(sensor.width);
+  header.height = static_cast<std::int16_t>(sensor.height);
+  std::vector<std::vector<std::uint8_t>> messages;
+  EventBatch chunk;
+  for (std::size_t begin = 0; begin < events.size(); begin += kEventsPerMessage) {
+    chunk.clear();
+    for (std::size_t i = begin; i < std::min(events.size(), begin + kEventsPerMessage); ++i) chunk.push_back(events[i]);
+    header.seq = static_cast<std::int64_t>(messages.size());
+    encode_event_batch(header, chunk, messages.emplace_back());
+  }
+  EventBatch received;
+  return time_op(settings, [&] {
+    EventBatchReceiver receiver(sensor, 1000);  // a new one each time: the sequence starts again
+    for (const auto& message : messages) {
+      if (!receiver.receive(message, received)) throw std::runtime_error("the receiver refused a benchmark message");
+    }
+  });
+}
+
 Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   const Scene scene = make_scene(size_case.scene);
   const EventBatch events = simulate(scene, settings.window_us);
@@ -133,6 +163,7 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
                            }),
                            n);
   structs = {};
+  f.receive = per_item(time_receive(settings, scene.sensor, events), n);
 
   // The passes run on the state at the end of the window.
   DeterministicPipeline busy(config);
@@ -232,9 +263,9 @@ std::optional<Figures> measure_in_child(const SizeCase& size_case, const BenchSe
 }
 
 void print_header() {
-  std::printf("%-9s %-17s %7s %9s %9s %10s %11s %10s %12s %8s %8s %10s %9s %8s\n", "size", "scene", "Mev/s*", "storage",
-              "(AoS)", "detect", "ns/point", "track", "ns/line", "copy", "1ms-upd", "pipeline", "lattice", "RSS");
-  std::printf("%-9s %-17s %7s %9s %9s %10s %11s %10s %12s %8s %8s %10s %9s %8s\n", "", "", "scene", "Mev/s", "Mev/s", "Hz",
+  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %8s %8s %10s %9s %8s\n", "size", "scene", "Mev/s*", "storage",
+              "(AoS)", "receive", "detect", "ns/point", "track", "ns/line", "copy", "1ms-upd", "pipeline", "lattice", "RSS");
+  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %8s %8s %10s %9s %8s\n", "", "", "scene", "Mev/s", "Mev/s", "Mev/s", "Hz",
               "(points)", "Hz", "(lines)", "us", "us", "Mev/s", "MB", "MB");
 }
 
@@ -242,8 +273,9 @@ void print_row(const SizeCase& c, const Figures& f) {
   char points[32], lines[32];
   std::snprintf(points, sizeof points, "%.1f (%.0f)", f.detect.median * 1e9 / std::max(f.active_points, 1.0), f.active_points);
   std::snprintf(lines, sizeof lines, "%.0f (%.0f)", f.track.median * 1e9 / std::max(f.lines_tracked, 1.0), f.lines_tracked);
-  std::printf("%-9s %-17s %7.2f %9.1f %9.1f %10.0f %11s %10.0f %12s %8.1f %8.1f %10.2f %9.2f %8.0f\n", c.label, c.scene,
-              f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median, 1.0 / f.detect.median, points,
+  std::printf("%-9s %-17s %7.2f %9.1f %9.1f %9.1f %10.0f %11s %10.0f %12s %8.1f %8.1f %10.2f %9.2f %8.0f\n", c.label, c.scene,
+              f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median, 1e-6 / f.receive.median,
+              1.0 / f.detect.median, points,
               1.0 / f.track.median, lines, f.snapshot.median * 1e6, f.snapshot_1ms.median * 1e6, 1e-6 / f.pipeline.median,
               f.lattice_mb, f.peak_rss_mb);
   std::fflush(stdout);
@@ -266,12 +298,14 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
         << "      \"events\": " << f.events << ",\n      \"scene_rate_mev_s\": " << f.scene_rate_mev_s << ",\n";
     write_timing(out, "storage_ns_per_event", f.storage, "ns", 1e9);
     write_timing(out, "storage_aos_ns_per_event", f.storage_aos, "ns", 1e9);
+    write_timing(out, "receive_ns_per_event", f.receive, "ns", 1e9);
     write_timing(out, "detect_pass_us", f.detect, "us", 1e6);
     write_timing(out, "track_pass_us", f.track, "us", 1e6);
     write_timing(out, "snapshot_us", f.snapshot, "us", 1e6);
     write_timing(out, "snapshot_after_1ms_us", f.snapshot_1ms, "us", 1e6);
     write_timing(out, "pipeline_ns_per_event", f.pipeline, "ns", 1e9);
     out << "      \"storage_mev_s\": " << 1e-6 / f.storage.median << ",\n"
+        << "      \"receive_mev_s\": " << 1e-6 / f.receive.median << ",\n"
         << "      \"detect_hz\": " << 1.0 / f.detect.median << ",\n"
         << "      \"detect_ns_per_active_point\": " << f.detect.median * 1e9 / std::max(f.active_points, 1.0) << ",\n"
         << "      \"active_points\": " << f.active_points << ",\n      \"lines_created\": " << f.lines_created << ",\n"
