@@ -18,6 +18,6 @@ if [[ "${1:-}" == "--quick" ]]; then
 fi
 build/release/tools/evldt-bench/evldt-bench "${core_args[@]}" --json out/bench/core.json
 echo
-tools/lcm-throughput-bench.sh "${lcm_args[@]}" --scene three-lines-fast --speeds "0.5 1 2 3 4" --json out/bench/lcm-640x480.json
+tools/lcm-throughput-bench.sh "${lcm_args[@]}" --scene three-lines-fast --speeds "0.5 1 2 2.6 3 4" --json out/bench/lcm-640x480.json
 echo
 tools/lcm-throughput-bench.sh "${lcm_args[@]}" --scene monitor-hd --speeds "0.1 0.25 0.5" --json out/bench/lcm-1280x720.json
