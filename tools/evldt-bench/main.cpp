@@ -136,7 +136,8 @@ Timing time_receive(const BenchSettings& settings, SensorSize sensor, const Even
   }
   EventBatch received;
   return time_op(settings, [&] {
-    EventBatchReceiver receiver(sensor, 1000);  // a new one each time: the sequence starts again
+    // A new one each time (the sequence starts again), with the services' default 1 ms time slack.
+    EventBatchReceiver receiver(sensor, 1000);
     for (const auto& message : messages) {
       if (!receiver.receive(message, received)) throw std::runtime_error("the receiver refused a benchmark message");
     }

@@ -133,7 +133,7 @@ class ScarfLattice {
     std::uint16_t* surface;  ///< null without keep_surface
     std::size_t width;
     std::uint16_t capacity;
-    std::uint64_t version;
+    std::uint64_t version;  ///< what every block this call writes takes as its version
   };
 
   Rings begin_change() {
