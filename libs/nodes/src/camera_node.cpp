@@ -54,8 +54,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
     throw std::runtime_error(source->name() + " has no sensor size in its header: pass --width and --height");
   }
   if (!sensor->valid()) {
-    throw std::runtime_error("sensor size " + std::to_string(sensor->width) + "x" + std::to_string(sensor->height) +
-                             " is not in 1x1.." + std::to_string(kMaxSensorSide) + "x" + std::to_string(kMaxSensorSide));
+    throw std::runtime_error(sensor->range_error());
   }
   summary.sensor = *sensor;
   EventValidator validator(*sensor, options_.time_slack_us);

@@ -22,8 +22,7 @@ std::uint64_t next_lattice_id() {
 
 LatticeGeometry LatticeGeometry::make(SensorSize sensor, int block_size, double alpha) {
   if (!sensor.valid()) {
-    throw std::invalid_argument("sensor size " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height) +
-                                " is not in 1.." + std::to_string(kMaxSensorSide));
+    throw std::invalid_argument(sensor.range_error());
   }
   if (block_size < 2 || block_size % 2 != 0 || block_size > 128) {
     throw std::invalid_argument("block size " + std::to_string(block_size) + " must be even and in 2..128");

@@ -22,8 +22,7 @@ constexpr double kMinThreshold = 0.01;
 FrameDifferenceEmulator::FrameDifferenceEmulator(SensorSize sensor, const FrameDifferenceConfig& config)
     : sensor_(sensor), config_(config), counts_(std::size_t{1} << kRadixBits) {
   if (!sensor.valid()) {
-    throw std::invalid_argument("sensor size must be in 1x1.." + std::to_string(kMaxSensorSide) + "x" +
-                                std::to_string(kMaxSensorSide));
+    throw std::invalid_argument(sensor.range_error());
   }
   if (!(config.contrast_on > 0) || !(config.contrast_off > 0) || !(config.log_offset > 0) || config.refractory_us < 0) {
     throw std::invalid_argument("contrast thresholds and log_offset must be positive, refractory_us not negative");

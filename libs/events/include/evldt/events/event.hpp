@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace evldt {
@@ -23,6 +24,11 @@ struct SensorSize {
   /// Both sides in 1..kMaxSensorSide.
   [[nodiscard]] bool valid() const {
     return width > 0 && height > 0 && width <= kMaxSensorSide && height <= kMaxSensorSide;
+  }
+  /// The error message for a size valid() refuses.
+  [[nodiscard]] std::string range_error() const {
+    const std::string side = std::to_string(kMaxSensorSide);
+    return "sensor size " + std::to_string(width) + "x" + std::to_string(height) + " is not in 1x1.." + side + "x" + side;
   }
   friend bool operator==(const SensorSize&, const SensorSize&) = default;
 };
