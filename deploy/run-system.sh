@@ -48,7 +48,18 @@ viz_args=(--camera "$camera_name" --show-ids --png-dir "$out/png" --png-period-s
 ((window)) || viz_args+=(--headless --video "$out/viz.mp4")
 "$bin/services/evldt-viz/evldt-viz" "${viz_args[@]}" >"$out/viz.txt" 2>"$out/viz.log" &
 pids+=($!)
-sleep 0.5  # the subscribers are up before the first batch
+# The subscribers are up before the first batch: each service logs "<name> ready:" once subscribed.
+wait_ready() {  # wait_ready LOG SERVICE
+  for _ in $(seq 600); do
+    grep -q "$2 ready:" "$1" && return 0
+    sleep 0.05
+  done
+  echo "evldt: $2 did not get ready within 30 s; its log: $1" >&2
+  stop_all
+  exit 1
+}
+wait_ready "$out/lines.log" evldt-lines
+wait_ready "$out/viz.log" evldt-viz
 echo "evldt: camera ${camera_args[*]} -> EVENTS_${camera_name^^} -> evldt-lines -> LINES_${camera_name^^} (Ctrl-C stops all)"
 camera_status=0
 "$bin/services/evldt-camera/evldt-camera" --camera "$camera_name" "${camera_args[@]}" >"$out/camera.txt" 2> >(tee "$out/camera.log" >&2) &

@@ -61,10 +61,10 @@ printf '%-7s %10s %14s %11s %11s %10s %14s\n' speed "Mev/s" "batches lost" "came
 rows=()
 best=0
 for speed in $speeds; do
-  "$lines" --lcm-url "$url" --publish-hz "$publish_hz" --log-period-s 0 --log-level warn >"$work/lines.out" 2>"$work/lines.err" &
+  "$lines" --lcm-url "$url" --publish-hz "$publish_hz" --log-period-s 0 >"$work/lines.out" 2>"$work/lines.err" &
   lines_pid=$!
   pids+=("$lines_pid")
-  sleep 0.3
+  for _ in $(seq 1200); do grep -q "evldt-lines ready:" "$work/lines.err" && break; sleep 0.05; done
   "$camera" "$recording" --lcm-url "$url" --speed "$speed" --loop --quiet --log-level warn >"$work/camera.out" 2>"$work/camera.err" &
   camera_pid=$!
   pids+=("$camera_pid")

@@ -2,11 +2,13 @@
 // EVENTS_<CAMERA>, paced at real time or a speed factor.
 
 #include <CLI/CLI.hpp>
+#include <spdlog/fmt/fmt.h>
 
 #include "evldt/app/lcm_options.hpp"
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/source_options.hpp"
 #include "evldt/nodes/camera_node.hpp"
+#include "evldt/transport/channels.hpp"
 
 int main(int argc, char** argv) {
   using namespace evldt;
@@ -45,6 +47,7 @@ int main(int argc, char** argv) {
     const auto& stop = stop_on_signals();
     const auto lcm = lcm_options.connect();
     CameraNode node(*lcm, options, process_epoch_us());
+    announce_ready("evldt-camera", fmt::format("publishing on {} ({})", events_channel(options.camera), lcm_options.effective_url()));
     const CameraSummary summary =
         node.run([&] { return source_options.open(options.time_slack_us); }, stop);
     summary.print(stdout);

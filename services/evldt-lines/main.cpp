@@ -39,8 +39,8 @@ int main(int argc, char** argv) {
     const auto& stop = stop_on_signals();
     const auto lcm = lcm_options.connect();
     LinesNode node(*lcm, options, process_epoch_us());
-    spdlog::info("listening on {} ({}), publishing {} at {} Hz", events_channel(options.camera), lcm_options.effective_url(),
-                 lines_channel(options.camera), options.publish_hz);
+    announce_ready("evldt-lines", fmt::format("listening on {} ({}), publishing {} at {} Hz", events_channel(options.camera),
+                                              lcm_options.effective_url(), lines_channel(options.camera), options.publish_hz));
     node.run(stop);
     const LinesNodeTotals t = node.totals();
     std::printf(

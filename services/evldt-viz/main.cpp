@@ -13,6 +13,7 @@
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/nodes/viz_node.hpp"
 #include "evldt/render/frame_writer.hpp"
+#include "evldt/transport/channels.hpp"
 
 int main(int argc, char** argv) {
   using namespace evldt;
@@ -48,6 +49,8 @@ int main(int argc, char** argv) {
     const auto& stop = stop_on_signals();
     const auto lcm = lcm_options.connect();
     VizNode node(*lcm, options);
+    announce_ready("evldt-viz", fmt::format("listening on {}, {} and {} ({})", events_channel(options.camera),
+                                            lines_channel(options.camera), kStatsChannel, lcm_options.effective_url()));
     std::optional<FrameWriter> video_writer, png_writer;
     const auto png_period = std::chrono::duration<double>(png_period_s);
     auto next_png = std::chrono::steady_clock::now();
@@ -68,7 +71,7 @@ int main(int argc, char** argv) {
       }
       return true;
     });
-    const VizTotals& t = node.totals();
+    const VizTotals t = node.totals();
     std::printf("evldt-viz summary\n"
                 "  frames    %llu drawn, %d in the video, %d PNG snapshots\n"
                 "  received  %llu batches (%llu lost, %llu invalid), %llu segment lists (%llu invalid), %llu stats\n",

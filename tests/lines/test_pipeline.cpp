@@ -143,8 +143,10 @@ TEST(RealtimeEngine, FindsTheSweepingEdgeOnItsOwnThreads) {
     engine.process(chunk);
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
+  // The loops run on their own threads: wait for the lines (a loaded machine is slow, not wrong).
   std::vector<TrackedLine> lines;
-  for (int attempt = 0; attempt < 200 && lines.size() < 10; ++attempt) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (lines.size() < 10 && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     engine.snapshot(lines);
   }

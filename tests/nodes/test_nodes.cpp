@@ -291,5 +291,48 @@ TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
   EXPECT_LT(red, 60);
 }
 
+// A frame that takes longer than its period (a slow machine, a big sensor at a high --fps) must not
+// starve the messages: everything that arrived before a frame is in it.
+TEST(Nodes, VizThatDrawsSlowlyStillHandlesEveryMessageBeforeEachFrame) {
+  lcm::LCM lcm("memq://");
+  VizNodeOptions options;
+  options.render_hz = 200;  // a 5 ms period; each frame below takes 30 ms, so the next is always due
+  VizNode viz(lcm, options);
+  event_batch_t batch;
+  batch.width = 240;
+  batch.height = 180;
+  std::vector<std::uint8_t> bytes;
+  auto publish_batch = [&](int seq) {
+    EventBatch events;
+    events.push_back(1000 * seq, static_cast<std::uint16_t>(10 + seq), 50, 1);
+    batch.seq = seq;
+    encode_event_batch(batch, events, bytes);
+    publish_raw(lcm, "EVENTS_CAM0", bytes);
+  };
+  publish_batch(0);
+  constexpr int kBatches = 40;
+  std::vector<VizTotals> at_frame;
+  const std::atomic<bool> never{false};
+  viz.run(never, [&](const cv::Mat&) {
+    at_frame.push_back(viz.totals());
+    if (at_frame.size() == 1) {
+      // Messages arrive while the first frame is being drawn.
+      for (int seq = 1; seq < kBatches; ++seq) publish_batch(seq);
+      segment_list_t list;
+      fill_segment_list(std::span<const TrackedLine>(), list);
+      list.width = 240;
+      list.height = 180;
+      publish_raw(lcm, "LINES_CAM0", encode(list));
+    }
+    std::this_thread::sleep_for(30ms);
+    return at_frame.size() < 2;
+  });
+  ASSERT_EQ(at_frame.size(), 2u);
+  EXPECT_EQ(at_frame[0].events.sequence.received, 1u);
+  EXPECT_EQ(at_frame[1].events.sequence.received, static_cast<std::uint64_t>(kBatches));
+  EXPECT_EQ(at_frame[1].segment_lists, 1u);
+  EXPECT_EQ(at_frame[1].events.sequence.lost, 0u);
+}
+
 }  // namespace
 }  // namespace evldt

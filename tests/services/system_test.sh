@@ -20,17 +20,25 @@ lines_pid=$!
 "$viz" --lcm-url "$url" --headless --video "$work/viz.mp4" --png-dir "$work/png" --png-period-s 0.5 --fps 20 \
   >"$work/viz.out" 2>"$work/viz.err" &
 viz_pid=$!
-sleep 1
+"$probe" "$url" cam0 600 >"$work/probe.out" &
+probe_pid=$!
+wait_logger_ready "$url" "$work/live.lcm" TEST_MARKER
+wait_ready "$work/lines.err" evldt-lines
+wait_ready "$work/viz.err" evldt-viz
+wait_until "the probe to subscribe" grep -q '^ready' "$work/probe.out"
 "$junk" "$url" EVENTS_CAM0 8
 "$camera" --lcm-url "$url" "${scene[@]}" -q >"$work/camera.out" 2>"$work/camera.err"
 check "camera exits 0" test $? -eq 0
-sleep 0.5
-check "evldt-lines stops within 1 s of SIGTERM" stops_within_a_second "$lines_pid"
-check "evldt-viz stops within 1 s of SIGTERM" stops_within_a_second "$viz_pid"
-stops_within_a_second "$logger_pid" INT
+batches=$(field "$work/camera.out" 'batches')
+check "evldt-lines published a segment list that includes the last batch" \
+  wait_until "a segment list including batch $((batches - 1))" probe_heard_batch "$work/probe.out" $((batches - 1))
+check "lcm-logger recorded every batch" wait_until "$batches batches in the log" log_holds "$url" "$work/live.lcm" EVENTS_CAM0 "$batches"
+check "evldt-lines stops promptly at SIGTERM" stops_promptly "$lines_pid"
+check "evldt-viz stops promptly at SIGTERM" stops_promptly "$viz_pid"
+stops_promptly "$logger_pid" INT
+kill "$probe_pid"
 cat "$work/camera.out" "$work/lines.out" "$work/viz.out"
 
-batches=$(field "$work/camera.out" 'batches')
 check "lines received every batch ($batches)" grep -q "batches   $batches received, 0 lost" "$work/lines.out"
 check "junk counted as 8 invalid messages" grep -q " 8 invalid messages" "$work/lines.out"
 check "lines stored events" test "$(field "$work/lines.out" 'events')" -gt 100000
@@ -53,15 +61,22 @@ check "live F@1% within 0.06 of offline" close_to "$live_f" "$offline_f" 0.06
 check "live F@1% >= 0.75" close_to "$live_f" 0.875 0.125
 
 # --- replay: lcm-logplayer feeds the recorded events to a fresh lines service ------------------
-lcm-logger --lcm-url="$replay_url" -f -q --channel='LINES_.*' "$work/replay.lcm" &
+lcm-logger --lcm-url="$replay_url" -f -q --channel='LINES_.*|TEST_MARKER' "$work/replay.lcm" &
 replay_logger_pid=$!
 "$lines" --lcm-url "$replay_url" --log-period-s 0 >"$work/replay_lines.out" 2>"$work/replay_lines.err" &
 replay_lines_pid=$!
-sleep 1
+"$probe" "$replay_url" cam0 600 >"$work/replay_probe.out" &
+replay_probe_pid=$!
+wait_logger_ready "$replay_url" "$work/replay.lcm" TEST_MARKER
+wait_ready "$work/replay_lines.err" evldt-lines
+wait_until "the probe to subscribe" grep -q '^ready' "$work/replay_probe.out"
 lcm-logplayer --lcm-url="$replay_url" --regexp='EVENTS_.*' "$work/live.lcm"
-sleep 0.5
-stops_within_a_second "$replay_lines_pid"
-stops_within_a_second "$replay_logger_pid" INT
+wait_until "a replayed segment list including batch $((batches - 1))" probe_heard_batch "$work/replay_probe.out" $((batches - 1))
+replay_lists=$(grep -c '^list' "$work/replay_probe.out")
+wait_until "$replay_lists segment lists in the replay log" log_holds "$replay_url" "$work/replay.lcm" LINES_CAM0 "$replay_lists"
+stops_promptly "$replay_lines_pid"
+stops_promptly "$replay_logger_pid" INT
+kill "$replay_probe_pid"
 cat "$work/replay_lines.out"
 check "replayed lines received every batch" grep -q "batches   $batches received, 0 lost" "$work/replay_lines.out"
 "$eval_tool" --segments "$work/replay.lcm" "${scene[@]}" --json "$work/replay.json" >/dev/null 2>&1

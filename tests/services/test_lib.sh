@@ -9,6 +9,7 @@ eval_tool=$build/tools/evldt-eval/evldt-eval
 junk=$build/tests/lcm_publish_junk
 probe=$build/tests/lcm_lines_probe
 relay=$build/tests/lcm_lossy_relay
+log_count=$build/tests/lcm_log_count
 work=$(mktemp -d)
 failures=0
 cleanup_hooks=()
@@ -25,12 +26,57 @@ check() {  # check DESCRIPTION COMMAND...
   if "$@"; then echo "ok: $what"; else echo "FAILED: $what"; failures=$((failures + 1)); fi
 }
 
-# Sends SIGTERM (or $2) and checks the process is gone within a second.
-stops_within_a_second() {
-  local pid=$1 signal=${2:-TERM}
+# Every wait is for a condition, with a deadline generous enough for a loaded machine and a
+# sanitizer build; a wait that times out says what it waited for.
+wait_limit_s=${EVLDT_TEST_WAIT_S:-90}
+
+wait_until() {  # wait_until DESCRIPTION COMMAND...: polls COMMAND every 50 ms until it succeeds
+  local what=$1
+  shift
+  local deadline=$((SECONDS + wait_limit_s))
+  until "$@"; do
+    if ((SECONDS >= deadline)); then
+      echo "timed out after ${wait_limit_s} s waiting for $what"
+      return 1
+    fi
+    sleep 0.05
+  done
+}
+
+wait_ready() {  # wait_ready LOG_FILE SERVICE: the service has logged "<SERVICE> ready:" (it is subscribed)
+  wait_until "$2 to log its readiness in $(basename "$1")" grep -q "$2 ready:" "$1"
+}
+
+# The stock lcm-logger says nothing when it has subscribed: publish a marker on MARKER_CHANNEL
+# until its log holds one (the logger must record that channel).
+wait_logger_ready() {  # wait_logger_ready URL LOG_FILE MARKER_CHANNEL
+  wait_until "lcm-logger to record into $(basename "$2")" logger_has_marker "$@"
+}
+logger_has_marker() {
+  "$junk" "$1" "$3" 1 && sleep 0.1 && test "$("$log_count" "$2" "$3")" -gt 0
+}
+
+# lcm-logger flushes its file only when a message arrives (at most every 100 ms), so each look
+# publishes a marker too: what it has received reaches the file.
+log_holds() {  # log_holds URL LOG_FILE CHANNEL COUNT: the log has at least COUNT messages on CHANNEL
+  "$junk" "$1" TEST_MARKER 1 && test "$("$log_count" "$2" "$3")" -ge "$4"
+}
+
+probe_heard_batch() {  # probe_heard_batch PROBE_OUT SEQ [EPOCH]: a segment list included batch SEQ
+  awk -v seq="$2" -v epoch="${3:-}" '$1 == "list" && $6 >= seq && (epoch == "" || $3 == epoch) { found = 1 } END { exit !found }' "$1"
+}
+
+# Sends SIGTERM (or $2) and checks that the process ends promptly, printing how long it took. The
+# services stop within a second on an idle machine; the limit leaves room for a loaded one.
+stops_promptly() {
+  local pid=$1 signal=${2:-TERM} started=$EPOCHREALTIME
   kill -s "$signal" "$pid"
-  for _ in $(seq 20); do
-    kill -0 "$pid" 2>/dev/null || { wait "$pid"; return 0; }
+  for _ in $(seq 200); do
+    if ! kill -0 "$pid" 2>/dev/null; then
+      wait "$pid"
+      echo "stopped by SIG$signal in $(awk -v a="$started" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.0f", (b - a) * 1000 }') ms"
+      return 0
+    fi
     sleep 0.05
   done
   return 1

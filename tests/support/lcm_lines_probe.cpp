@@ -1,9 +1,9 @@
-// Test helper: a subscriber on a far host, as a robot's consumer of evldt would be. Prints one line
-// per message it hears, for the fault and multi-host tests to check:
-//   list RECV_WALL_US EPOCH SEQ T_US NUM_SEGMENTS ID...
+// Test helper: a subscriber on a far host, as a robot's consumer of evldt would be. Prints "ready"
+// once subscribed, then one line per message it hears, for the service tests to check and wait on:
+//   list RECV_WALL_US EPOCH SEQ T_US NEWEST_BATCH_SEQ NUM_SEGMENTS ID...
 //   stats RECV_WALL_US EPOCH BATCHES_RECEIVED BATCHES_LOST INVALID_MESSAGES
 //   invalid RECV_WALL_US CHANNEL
-// Usage: lcm_lines_probe URL CAMERA SECONDS
+// Usage: lcm_lines_probe URL CAMERA SECONDS   (it stops after SECONDS, or at SIGTERM)
 
 #include <cinttypes>
 #include <cstdio>
@@ -24,8 +24,8 @@ struct Probe {
   void on_list(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
     evldt::segment_list_t list;
     if (evldt::decode_message(payload_of(buffer), list) != evldt::WireError::None) return invalid(channel);
-    std::printf("list %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %d", evldt::wall_clock_us(), list.epoch, list.seq,
-                list.t_us, list.num_segments);
+    std::printf("list %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %d", evldt::wall_clock_us(), list.epoch,
+                list.seq, list.t_us, list.newest_batch_seq, list.num_segments);
     for (const auto& segment : list.segments) std::printf(" %" PRId64, segment.id);
     std::printf("\n");
   }
@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
   Probe probe;
   lcm.subscribe(evldt::lines_channel(argv[2]), &Probe::on_list, &probe);
   lcm.subscribe(std::string(evldt::kStatsChannel), &Probe::on_stats, &probe);
+  std::printf("ready\n");
+  std::fflush(stdout);
   const std::int64_t end = evldt::wall_clock_us() + static_cast<std::int64_t>(std::atof(argv[3]) * 1e6);
   while (evldt::wall_clock_us() < end) {
     if (lcm.handleTimeout(50) < 0) return 1;

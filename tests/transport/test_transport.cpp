@@ -478,7 +478,7 @@ TEST(Pacer, UnlimitedSpeedNeverWaits) {
   const auto start = std::chrono::steady_clock::now();
   pacer.wait_until(0, stop);
   pacer.wait_until(3'600'000'000, stop);
-  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));  // not the hour; room for a loaded machine
 }
 
 TEST(Pacer, AJumpOfEventTimeIsNotWaitedThrough) {
@@ -508,7 +508,7 @@ TEST(Pacer, WaitsForEventTimeAndHonoursStop) {
   stop = true;
   const auto stopped = std::chrono::steady_clock::now();
   pacer.wait_until(3'600'000'000, stop);  // an hour, but stop is set
-  EXPECT_LT(std::chrono::steady_clock::now() - stopped, std::chrono::seconds(1));
+  EXPECT_LT(std::chrono::steady_clock::now() - stopped, std::chrono::seconds(10));
 }
 
 // ---- lcm-logger files ---------------------------------------------------------------------------

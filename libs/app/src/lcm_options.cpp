@@ -2,7 +2,9 @@
 
 #include <csignal>
 #include <cstdlib>
+#include <spdlog/spdlog.h>
 #include <stdexcept>
+#include <systemd/sd-daemon.h>
 
 #include "evldt/transport/channels.hpp"
 
@@ -44,6 +46,12 @@ std::unique_ptr<lcm::LCM> LcmOptions::connect() const {
                              "'ip route add 224.0.0.0/4 dev lo'; see deploy/README.md)");
   }
   return lcm;
+}
+
+void announce_ready(std::string_view service, std::string_view what) {
+  spdlog::info("{} ready: {}", service, what);
+  const std::string status = fmt::format("READY=1\nSTATUS={}", what);
+  if (sd_notify(0, status.c_str()) < 0) spdlog::warn("could not tell systemd that {} is ready", service);
 }
 
 const std::atomic<bool>& stop_on_signals() {

@@ -11,8 +11,6 @@
 namespace evldt {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 std::span<const std::uint8_t> payload_of(const lcm::ReceiveBuffer* buffer) {
   return {static_cast<const std::uint8_t*>(buffer->data), buffer->data_size};
 }
@@ -96,14 +94,32 @@ void VizNode::render(cv::Mat& canvas) {
   }
 }
 
+bool VizNode::handle_pending(Clock::time_point deadline) {
+  while (Clock::now() < deadline) {
+    const int handled = lcm_.handleTimeout(0);
+    if (handled < 0) return false;
+    if (handled == 0) return true;
+  }
+  return true;
+}
+
 void VizNode::run(const std::atomic<bool>& stop, const FrameHandler& on_frame) {
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / options_.render_hz));
   auto next_frame = Clock::now() + period;
   auto last_rate = Clock::now();
   cv::Mat canvas;
+  bool lcm_failed = false;
   while (!stop.load()) {
-    const auto now = Clock::now();
+    auto now = Clock::now();
     if (now >= next_frame) {
+      // Everything that has arrived goes into the frame, for at most one period: a frame that takes
+      // longer than its period would otherwise let only one message in between frames, and the
+      // picture would fall ever further behind the stream.
+      if (!handle_pending(now + period)) {
+        lcm_failed = true;
+        break;
+      }
+      now = Clock::now();
       next_frame = std::max(next_frame + period, now);
       const double elapsed = std::chrono::duration<double>(now - last_rate).count();
       event_rate_ = static_cast<double>(events_since_frame_) / elapsed;
@@ -118,11 +134,22 @@ void VizNode::run(const std::atomic<bool>& stop, const FrameHandler& on_frame) {
     }
     const auto wait_ms = std::chrono::duration_cast<std::chrono::milliseconds>(next_frame - now).count();
     if (lcm_.handleTimeout(static_cast<int>(std::clamp<long long>(wait_ms, 1, 100))) < 0 && !stop.load()) {
-      spdlog::error("LCM receive failed; stopping");  // a stop signal interrupting the wait is not a failure
+      lcm_failed = true;  // a stop signal interrupting the wait is not a failure
       break;
     }
   }
-  totals_.events = receiver_.counts();
+  if (lcm_failed) {
+    spdlog::error("LCM receive failed; stopping");
+  } else {
+    // What had arrived before the stop is counted in the summary (bounded: stopping stays prompt).
+    handle_pending(Clock::now() + kStopDrain);
+  }
+}
+
+VizTotals VizNode::totals() const {
+  VizTotals totals = totals_;
+  totals.events = receiver_.counts();
+  return totals;
 }
 
 }  // namespace evldt

@@ -7,6 +7,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace evldt {
 
@@ -26,6 +27,11 @@ class LcmOptions {
   std::string url_;
   std::string camera_ = "cam0";
 };
+
+/// Says that a service is ready: subscribed, so every message published from now on reaches it. Logs
+/// "<service> ready: <what>" at info level (tests and operators wait for that line) and tells
+/// systemd (READY=1, for Type=notify units; a no-op outside systemd).
+void announce_ready(std::string_view service, std::string_view what);
 
 /// Installs SIGINT and SIGTERM handlers that set the returned flag (once; later calls return it).
 const std::atomic<bool>& stop_on_signals();

@@ -4,6 +4,7 @@
 // renders frames at a set rate (surface, segments coloured by status, a status line).
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <optional>
@@ -42,11 +43,18 @@ class VizNode {
   VizNode& operator=(const VizNode&) = delete;
 
   /// Receives until `stop` is set (or the handler says stop), handing a frame to `on_frame` render_hz times a second once the
-  /// first event batch has arrived. Everything runs on the calling thread (window toolkits need it).
+  /// first event batch has arrived; every message received before a frame is due is in it. After a stop, handles what
+  /// has already arrived (for at most kStopDrain) so that the totals count it. Everything runs on the calling thread
+  /// (window toolkits need it).
   void run(const std::atomic<bool>& stop, const FrameHandler& on_frame);
-  [[nodiscard]] const VizTotals& totals() const { return totals_; }
+  /// Counts so far (call from the thread that runs the node, e.g. in the frame handler, or after run).
+  [[nodiscard]] VizTotals totals() const;
+  static constexpr std::chrono::milliseconds kStopDrain{200};
 
  private:
+  using Clock = std::chrono::steady_clock;
+  /// Handles messages until none is waiting or the deadline passes; false if LCM failed.
+  bool handle_pending(Clock::time_point deadline);
   void on_events(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void on_lines(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void on_stats(const lcm::ReceiveBuffer* buffer, const std::string& channel);

@@ -1,0 +1,30 @@
+# The builds the test suite runs in, shared by tests/run.sh and tests/stress-run.sh (sourced from
+# the source root): a Release build, AddressSanitizer + UndefinedBehaviorSanitizer, ThreadSanitizer.
+suites=(release asan tsan)
+jobs=$(nproc)
+
+# LCM hands messages between threads through GLib, whose futex-based mutexes TSan cannot see:
+# accesses made inside those uninstrumented libraries are not judged (our own code still is).
+# TSan's default sleeps 1 s at exit while other threads (OpenCV's pool) live: the service tests
+# time how fast a process stops, which that sleep would measure instead.
+export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 ignore_noninstrumented_modules=1 atexit_sleep_ms=0"
+
+suite_cmake_args() {  # suite_cmake_args NAME
+  case $1 in
+    release) echo -DCMAKE_BUILD_TYPE=Release ;;
+    asan) echo -DEVLDT_SANITIZE=address ;;
+    tsan) echo -DEVLDT_SANITIZE=thread ;;
+    *) echo "unknown suite $1" >&2; return 1 ;;
+  esac
+}
+
+build_suite() {  # build_suite NAME: configure and build build/NAME
+  cmake -S . -B "build/$1" -G Ninja $(suite_cmake_args "$1") >/dev/null
+  cmake --build "build/$1" -j "$jobs"
+}
+
+test_suite() {  # test_suite NAME [CTEST_ARGS...]: every test of build/NAME
+  local name=$1
+  shift
+  (cd "build/$name" && ctest --output-on-failure -j "$jobs" --timeout 900 "$@")
+}
