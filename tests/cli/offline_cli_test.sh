@@ -83,4 +83,22 @@ paste -d' ' "$work/from_file.txt" "$work/in_process.txt" | awk '{ n = NF / 2; fo
   fail "file and in-process evaluation differ: $(cat "$work/from_file.txt") vs $(cat "$work/in_process.txt")"
 [[ -s "$work/life.png" ]] || fail "no lifetime histogram"
 echo "ok: evaluation of ground truth against itself is perfect; file and in-process scores agree: $(cat "$work/in_process.txt")"
-echo "offline CLI: 8 passed, 0 failed"
+
+# Every ground-truth step counts: an empty prediction is no score, one step of prediction is
+# charged for all the others, and the GT CSV and the scene give the same steps.
+head -1 "$work/p.csv" >"$work/empty.csv"
+"$eval" --segments "$work/empty.csv" --ground-truth "$work/rec/ground_truth.csv" --width 240 --height 180 >"$work/empty.txt"
+grep -Eq '^empty.csv +- +n/a +0.000 +0.000 +n/a +0.000 +0.000 +0.0 +[0-9.]+ +41 +41 ' "$work/empty.txt" ||
+  fail "an empty prediction must score P n/a, R 0, F 0 over all 41 steps: $(cat "$work/empty.txt")"
+awk -F, 'NR == 1 || $1 == 200000' "$work/p.csv" >"$work/one_step.csv"
+"$eval" --segments "$work/one_step.csv" --scene boxes-6dof --duration-s 0.4 --json "$work/one_step.json" >"$work/one_step.txt"
+one_step_recall=$(grep -oP '"recall"\s*:\s*\K[0-9.]+' "$work/one_step.json" | head -1)
+awk -v r="$one_step_recall" 'BEGIN { exit !(r > 0 && r < 0.1) }' || fail "one step of 41 must give recall < 0.1: $(cat "$work/one_step.txt")"
+grep -q '"predicted_steps_scored": 1' "$work/one_step.json" || fail "one predicted step scored: $(cat "$work/one_step.json")"
+"$eval" --segments "$work/p.csv" --ground-truth "$work/rec/ground_truth.csv" --width 240 --height 180 | tail -1 |
+  awk '{ $1 = ""; $2 = ""; print }' >"$work/from_gt_csv.txt"
+paste -d' ' "$work/from_file.txt" "$work/from_gt_csv.txt" | awk '{ n = NF / 2; for (i = 1; i <= n; ++i) {
+    d = $i - $(i + n); if (d < 0) d = -d; if (d > 0.002) exit 1 } }' ||
+  fail "GT CSV and scene scores differ: $(cat "$work/from_gt_csv.txt") vs $(cat "$work/from_file.txt")"
+echo "ok: empty prediction -> P n/a, R 0, F 0; one step -> recall $one_step_recall over 41 steps; GT CSV and scene agree"
+echo "offline CLI: 9 passed, 0 failed"

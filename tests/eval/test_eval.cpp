@@ -14,6 +14,7 @@
 #include "evldt/eval/json.hpp"
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/eval/plots.hpp"
+#include "evldt/eval/scene_evaluation.hpp"
 
 namespace evldt {
 namespace {
@@ -69,10 +70,17 @@ TEST(Rasterise, MarksEveryPixelAlongTheSegmentAndClipsAtTheBorder) {
   EXPECT_EQ(line_pixels(map), 0u);
 }
 
-TEST(Prf, EmptyDenominatorsFollowTheDocumentedConvention) {
-  expect_prf(prf({}), 1, 1, 1);
-  expect_prf(prf({10, 0, 0}), 0, 1, 0);
-  expect_prf(prf({0, 10, 0}), 1, 0, 0);
+TEST(Prf, WhatHasNoDenominatorIsUndefinedNeverPerfect) {
+  const Prf nothing = prf({});
+  EXPECT_TRUE(std::isnan(nothing.precision) && std::isnan(nothing.recall) && std::isnan(nothing.f));
+  const Prf on_empty_scene = prf({10, 0, 0});
+  EXPECT_EQ(on_empty_scene.precision, 0);
+  EXPECT_TRUE(std::isnan(on_empty_scene.recall));
+  EXPECT_EQ(on_empty_scene.f, 0);
+  const Prf nothing_predicted = prf({0, 10, 0});
+  EXPECT_TRUE(std::isnan(nothing_predicted.precision));
+  EXPECT_EQ(nothing_predicted.recall, 0);
+  EXPECT_EQ(nothing_predicted.f, 0);
   expect_prf(prf({10, 20, 5}), 0.5, 0.25, 2 * 0.5 * 0.25 / 0.75);
 }
 
@@ -93,7 +101,7 @@ TEST(HeatmapMatcher, PerfectPredictionScoresOne) {
   EXPECT_EQ(counts.predicted, counts.ground_truth);
   EXPECT_EQ(counts.matched, counts.ground_truth);
   expect_prf(prf(counts), 1, 1, 1);
-  expect_prf(prf(matcher.match({}, {})), 1, 1, 1);
+  EXPECT_EQ(matcher.match({}, {}), (MatchCounts{0, 0, 0}));
 }
 
 TEST(HeatmapMatcher, ShiftWithinToleranceMatchesAndBeyondItDoesNot) {
@@ -238,7 +246,7 @@ TEST(HeatmapMatcher, AgreesWithTheMinCostReference) {
 TEST(EvaluationAccumulator, SumsCountsOverSteps) {
   EvaluationAccumulator accumulator;  // 1% and 2%
   ASSERT_EQ(accumulator.tolerance_fractions().size(), 2u);
-  expect_prf(accumulator.summed_prf(0), 1, 1, 1);
+  EXPECT_TRUE(std::isnan(accumulator.summed_prf(0).f));  // nothing scored is not a score
   const std::vector<MatchCounts> first = {{100, 80, 60}, {100, 80, 70}};
   const std::vector<MatchCounts> second = {{50, 70, 40}, {50, 70, 50}};
   accumulator.add_step(first, 10, 8);
@@ -248,13 +256,6 @@ TEST(EvaluationAccumulator, SumsCountsOverSteps) {
   EXPECT_EQ(accumulator.total(1), (MatchCounts{150, 150, 120}));
   expect_prf(accumulator.summed_prf(0), 2.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0);
   expect_prf(accumulator.summed_prf(1), 0.8, 0.8, 0.8);
-  ASSERT_EQ(accumulator.step_prf(0).size(), 2u);
-  EXPECT_DOUBLE_EQ(accumulator.step_prf(0)[1].precision, 0.8);
-  // Mean of steps: precision (0.6 + 0.8) / 2, recall (0.75 + 4/7) / 2.
-  const Prf mean = accumulator.mean_step_prf(0);
-  EXPECT_DOUBLE_EQ(mean.precision, 0.7);
-  EXPECT_DOUBLE_EQ(mean.recall, (0.75 + 4.0 / 7.0) / 2.0);
-  EXPECT_DOUBLE_EQ(mean.f, (prf(first[0]).f + prf(second[0]).f) / 2.0);
   EXPECT_DOUBLE_EQ(accumulator.mean_predicted_segments(), 7.5);
   EXPECT_DOUBLE_EQ(accumulator.mean_ground_truth_segments(), 7.5);
   EXPECT_THROW(accumulator.add_step(std::span(first).first(1), 1, 1), std::invalid_argument);
@@ -274,6 +275,121 @@ TEST(EvaluationAccumulator, TakesMatcherResults) {
   EXPECT_EQ(accumulator.total(0), (MatchCounts{123, 164, 82}));
   EXPECT_EQ(accumulator.total(1), (MatchCounts{123, 164, 123}));
   EXPECT_DOUBLE_EQ(accumulator.mean_predicted_segments(), 1.5);
+}
+
+// ---- scoring over the ground truth's steps ------------------------------------------------------
+
+// Ground truth at t = 0, 10, 20, 30, 40: one horizontal line that moves down 2 px a step (more than
+// the 1% tolerance of 1.25 px, less than the 2% one of 2.5 px).
+constexpr Timestamp kGtPeriod = 10;
+constexpr int kGtSteps = 5;
+
+Segment moving_line(std::size_t step) { return row_segment(10 + 2 * static_cast<int>(step), 10, 50); }
+
+GroundTruthSteps moving_truth() {
+  GroundTruthSteps steps;
+  for (int k = 0; k < kGtSteps; ++k) steps.times.push_back(k * kGtPeriod);
+  steps.segments_at = [](std::size_t index, std::vector<Segment>& out) { out.assign(1, moving_line(index)); };
+  return steps;
+}
+
+StreamEvaluator moving_evaluator() {
+  return StreamEvaluator(kSensor, {0.01, 0.02}, moving_truth(), std::llround(StreamEvaluator::kHoldPeriods * kGtPeriod));
+}
+
+void predict(StreamEvaluator& evaluator, Timestamp t, std::uint64_t id, std::vector<Segment> segments) {
+  const std::vector<std::uint64_t> ids(segments.size(), id);
+  evaluator.add_prediction(t, ids, segments);
+}
+
+TEST(StreamEvaluator, AnEmptyPredictionMissesEveryStep) {
+  StreamEvaluator evaluator = moving_evaluator();
+  evaluator.finish();
+  EXPECT_EQ(evaluator.accuracy().steps(), static_cast<std::uint64_t>(kGtSteps));
+  EXPECT_EQ(evaluator.accuracy().total(0), (MatchCounts{0, 41u * kGtSteps, 0}));
+  const Prf result = evaluator.accuracy().summed_prf(0);
+  EXPECT_TRUE(std::isnan(result.precision));  // reported n/a
+  EXPECT_EQ(result.recall, 0);
+  EXPECT_EQ(result.f, 0);
+  EXPECT_EQ(evaluator.coverage().steps_without_prediction, static_cast<std::uint64_t>(kGtSteps));
+}
+
+TEST(StreamEvaluator, OneStepOfPredictionIsHeldForOnePeriodAndRecallIsOverAllSteps) {
+  StreamEvaluator evaluator = moving_evaluator();
+  predict(evaluator, 20, 1, {moving_line(2)});  // exact at t = 20; held at t = 30 (10 <= 15), not at 40 (20 > 15)
+  evaluator.finish();
+  // Step 20 matches all 41 pixels; step 30 compares the line of 20 with the one 2 px lower: no match at 1%.
+  EXPECT_EQ(evaluator.accuracy().total(0), (MatchCounts{2 * 41, 5 * 41, 41}));
+  EXPECT_EQ(evaluator.accuracy().total(1), (MatchCounts{2 * 41, 5 * 41, 2 * 41}));
+  EXPECT_DOUBLE_EQ(evaluator.accuracy().summed_prf(1).recall, 2.0 / 5.0);
+  const StepCoverage& coverage = evaluator.coverage();
+  EXPECT_EQ(coverage.ground_truth_steps, 5u);
+  EXPECT_EQ(coverage.steps_without_prediction, 3u);  // 0, 10 (before it) and 40 (beyond its hold)
+  EXPECT_EQ(coverage.predicted_steps, 1u);
+  EXPECT_EQ(coverage.predicted_steps_scored, 1u);
+}
+
+TEST(StreamEvaluator, APredictionThatLagsOnePeriodIsScoredAgainstTheTruthOfItsStep) {
+  // The prediction stamped t shows the truth of t - 10: every step compares a line with the one 2 px
+  // above it, and step 0 has nothing yet.
+  StreamEvaluator lagging = moving_evaluator();
+  for (int k = 1; k < kGtSteps; ++k) predict(lagging, k * kGtPeriod, 7, {moving_line(static_cast<std::size_t>(k - 1))});
+  lagging.finish();
+  HeatmapMatcher tight(kSensor, 0.01), loose(kSensor, 0.02);
+  MatchCounts expected_tight{0, 41, 0}, expected_loose{0, 41, 0};
+  for (std::size_t k = 1; k < kGtSteps; ++k) {
+    const std::vector<Segment> predicted = {moving_line(k - 1)}, truth = {moving_line(k)};
+    expected_tight += tight.match(predicted, truth);
+    expected_loose += loose.match(predicted, truth);
+  }
+  EXPECT_EQ(lagging.accuracy().total(0), expected_tight);
+  EXPECT_EQ(lagging.accuracy().total(1), expected_loose);
+  EXPECT_EQ(expected_tight.matched, 0u);
+  EXPECT_EQ(expected_loose.matched, 4u * 41u);
+  EXPECT_EQ(lagging.coverage().steps_without_prediction, 1u);
+
+  // Stamped half a period late instead (t + 5 shows the truth of t): each step sees the one before.
+  StreamEvaluator half_late = moving_evaluator();
+  for (int k = 0; k < kGtSteps; ++k) predict(half_late, k * kGtPeriod + 5, 7, {moving_line(static_cast<std::size_t>(k))});
+  half_late.finish();
+  EXPECT_EQ(half_late.accuracy().total(0), expected_tight);
+  EXPECT_EQ(half_late.accuracy().total(1), expected_loose);
+  EXPECT_EQ(half_late.coverage().predicted_steps_outside, 1u);  // t = 45, after the last step
+}
+
+TEST(StreamEvaluator, PredictionsOutsideTheGroundTruthRangeAreCountedNotScored) {
+  StreamEvaluator evaluator = moving_evaluator();
+  predict(evaluator, -100, 1, {moving_line(0)});  // long before the first step
+  for (int k = 0; k < kGtSteps; ++k) predict(evaluator, k * kGtPeriod, 2, {moving_line(static_cast<std::size_t>(k))});
+  predict(evaluator, 41, 3, {row_segment(70, 0, 99)});  // after the last step
+  predict(evaluator, 500, 3, {row_segment(70, 0, 99)});
+  evaluator.finish();
+  EXPECT_EQ(evaluator.accuracy().total(0), (MatchCounts{5 * 41, 5 * 41, 5 * 41}));
+  EXPECT_EQ(evaluator.coverage().predicted_steps, 8u);
+  EXPECT_EQ(evaluator.coverage().predicted_steps_scored, 5u);
+  EXPECT_EQ(evaluator.coverage().predicted_steps_outside, 3u);
+  EXPECT_EQ(evaluator.lifetimes().ids(), 3u);  // every predicted step counts for lifetimes
+  EXPECT_THROW(evaluator.add_prediction(600, {}, {}), std::logic_error);
+}
+
+TEST(StreamEvaluator, AStallInsideTheStreamCostsRecallAndTimeMayNotGoBack) {
+  StreamEvaluator evaluator = moving_evaluator();
+  predict(evaluator, 0, 1, {moving_line(0)});
+  predict(evaluator, 0, 1, {moving_line(0)});  // the same time again replaces the step
+  predict(evaluator, 40, 1, {moving_line(4)});  // nothing for 10, 20, 30: a stall
+  EXPECT_THROW(predict(evaluator, 39, 1, {}), std::invalid_argument);
+  evaluator.finish();
+  // Steps 0 and 40 exact; 10 holds the line of 0 (2 px off: loose tolerance only); 20 and 30 empty.
+  EXPECT_EQ(evaluator.accuracy().total(0), (MatchCounts{3 * 41, 5 * 41, 2 * 41}));
+  EXPECT_EQ(evaluator.accuracy().total(1), (MatchCounts{3 * 41, 5 * 41, 3 * 41}));
+  EXPECT_EQ(evaluator.coverage().steps_without_prediction, 2u);
+  EXPECT_EQ(evaluator.coverage().predicted_steps, 2u);
+}
+
+TEST(StreamEvaluator, MedianStepSpacingIsTheNominalOutputPeriod) {
+  const std::vector<Timestamp> jittered = {0, 9, 21, 30, 30, 41, 200};
+  EXPECT_EQ(median_step_spacing(jittered), 11);  // gaps 9, 12, 9, 11, 159
+  EXPECT_EQ(median_step_spacing(std::vector<Timestamp>{5}), 0);
 }
 
 TEST(LifetimeTracker, StatsAndHistogram) {

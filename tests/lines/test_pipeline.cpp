@@ -113,6 +113,17 @@ TEST(Pipeline, RoundsRunOnEventTimeAndLongGapsAreSkipped) {
   EXPECT_GT(pipeline.counters().skipped_rounds, 3000000u);
 }
 
+TEST(Pipeline, OutputStepsFallOnMultiplesOfThePeriodWhateverTheFirstEventTime) {
+  DeterministicPipeline pipeline(default_config_for(kSensor));
+  std::vector<Timestamp> steps;
+  pipeline.set_output(1000, [&](Timestamp t, const LineMap&, const ScarfLattice&) { steps.push_back(t); });
+  EventBatch batch;
+  batch.push_back(1234, 50, 50, 1);
+  batch.push_back(4100, 50, 50, 1);
+  pipeline.process(batch);
+  EXPECT_EQ(steps, (std::vector<Timestamp>{2000, 3000, 4000}));  // the grid ground truth is sampled on
+}
+
 TEST(Pipeline, AfterTheClockWentBackRoundsRunOnTheNewClock) {
   PipelineConfig config = default_config_for(kSensor);
   DeterministicPipeline pipeline(config);

@@ -2,11 +2,12 @@
 // ground truth, from files or by running the pipeline on a built-in scene (also over thresholds).
 
 #include <CLI/CLI.hpp>
-#include <iterator>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <cstdio>
 #include <fstream>
-#include <map>
 #include <spdlog/spdlog.h>
 
 #include "evldt/app/pipeline_options.hpp"
@@ -28,6 +29,7 @@ struct Options {
   std::vector<double> tolerances{0.01, 0.02};
   std::vector<float> pr_thresholds;
   Timestamp step_us = 10000;
+  Timestamp output_period_us = 0;  ///< of a segment file; 0: its median step spacing
   double histogram_bin_ms = 50;
 };
 
@@ -37,37 +39,75 @@ struct Report {
   std::vector<Prf> summed;
   double mean_predicted = 0, mean_ground_truth = 0;
   std::uint64_t steps = 0;
+  StepCoverage coverage;
+  Timestamp hold_us = 0;
   LifetimeSummary lifetime;
   std::uint64_t events = 0;
   double scene_seconds = 0, wall_seconds = 0;
 };
 
-Report make_report(const StepEvaluator& evaluator) {
+Report make_report(const StreamEvaluator& evaluator) {
   Report r;
   const auto& a = evaluator.accuracy();
   for (std::size_t i = 0; i < a.tolerance_fractions().size(); ++i) r.summed.push_back(a.summed_prf(i));
   r.mean_predicted = a.mean_predicted_segments();
   r.mean_ground_truth = a.mean_ground_truth_segments();
   r.steps = a.steps();
+  r.coverage = evaluator.coverage();
+  r.hold_us = evaluator.hold_us();
   r.lifetime = evaluator.lifetimes().summary();
   return r;
 }
 
-// Predictions and ground truth read from CSV files; ground truth of a step is the latest GT row time <= t.
-StepEvaluator evaluate_files(const Options& options, SensorSize sensor, const SimulatorOptions& sim) {
-  const auto rows = is_lcm_log(options.segments) ? read_segment_log(options.segments, options.lcm_channel)
-                                                 : read_segment_csv(options.segments);
-  std::map<Timestamp, std::vector<Segment>> gt_by_time;
-  if (!options.ground_truth.empty()) {
-    for (const auto& g : read_ground_truth_csv(options.ground_truth)) {
-      gt_by_time[g.t_us].push_back({g.segment.a.cast<float>(), g.segment.b.cast<float>()});
+// The event time an lcm-log's event batches span, if it has any: a recording of the live system is
+// scored over the time it recorded, so a stall inside it costs recall.
+std::optional<std::pair<Timestamp, Timestamp>> recorded_event_span(const std::filesystem::path& log,
+                                                                    const std::string& lines_channel) {
+  const std::string events_channel =
+      lines_channel.starts_with("LINES_") ? "EVENTS_" + lines_channel.substr(std::string_view("LINES_").size()) : "";
+  try {
+    LcmLogEventReader reader(log, events_channel, std::numeric_limits<Timestamp>::max() / 4);
+    std::optional<std::pair<Timestamp, Timestamp>> span;
+    EventBatch batch;
+    while (reader.read(batch)) {
+      for (const Timestamp t : batch.t) {
+        span = span ? std::pair(std::min(span->first, t), std::max(span->second, t)) : std::pair(t, t);
+      }
+    }
+    return span;
+  } catch (const std::runtime_error&) {
+    return std::nullopt;  // no event batches recorded: the ground truth's own range
+  }
+}
+
+// The rule is StreamEvaluator's: every ground-truth step, against the latest predicted step at or
+// before it within 1.5 output periods.
+StreamEvaluator evaluate_files(const Options& options, SensorSize sensor, const SimulatorOptions& sim) {
+  const bool from_log = is_lcm_log(options.segments);
+  std::vector<SegmentRow> rows =
+      from_log ? read_segment_log(options.segments, options.lcm_channel) : read_segment_csv(options.segments);
+  std::stable_sort(rows.begin(), rows.end(), [](const SegmentRow& a, const SegmentRow& b) { return a.t_us < b.t_us; });
+  GroundTruthSteps truth = sim.scene_selected() ? scene_ground_truth_steps(sim.scene(), options.step_us)
+                                                : csv_ground_truth_steps(read_ground_truth_csv(options.ground_truth));
+  if (from_log) {
+    if (const auto span = recorded_event_span(options.segments, options.lcm_channel)) {
+      const std::size_t before = truth.times.size();
+      std::erase_if(truth.times, [&](Timestamp t) { return t < span->first || t > span->second; });
+      spdlog::info("scoring the {} of {} ground-truth steps within the recorded events ({:.3f} .. {:.3f} s)",
+                   truth.times.size(), before, static_cast<double>(span->first) * 1e-6,
+                   static_cast<double>(span->second) * 1e-6);
     }
   }
-  const std::optional<Scene> scene = sim.scene_selected() ? std::optional<Scene>(sim.scene()) : std::nullopt;
-  StepEvaluator evaluator(sensor, options.tolerances);
+  std::vector<Timestamp> times;
+  for (const SegmentRow& row : rows) {
+    if (times.empty() || times.back() != row.t_us) times.push_back(row.t_us);
+  }
+  Timestamp period = options.output_period_us > 0 ? options.output_period_us : median_step_spacing(times);
+  if (period == 0) period = median_step_spacing(truth.times);  // fewer than two predicted steps
+  StreamEvaluator evaluator(sensor, options.tolerances, std::move(truth),
+                            std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(period)));
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted;
-  const std::vector<Segment> none;
   for (std::size_t i = 0; i < rows.size();) {
     const Timestamp t = rows[i].t_us;
     ids.clear();
@@ -76,28 +116,29 @@ StepEvaluator evaluate_files(const Options& options, SensorSize sensor, const Si
       ids.push_back(rows[i].id);
       predicted.push_back(rows[i].segment);
     }
-    if (scene) {
-      evaluator.add_step(t, ids, predicted, scene_ground_truth(*scene, t));
-    } else {
-      auto it = gt_by_time.upper_bound(t);
-      evaluator.add_step(t, ids, predicted, it == gt_by_time.begin() ? none : std::prev(it)->second);
-    }
+    evaluator.add_prediction(t, ids, predicted);
   }
+  evaluator.finish();
   return evaluator;
 }
+
+// An undefined ratio (nothing predicted, or no ground truth) is "n/a", never a perfect or zero score.
+std::string figure(double value) { return std::isfinite(value) ? fmt::format("{:.3f}", value) : "n/a"; }
 
 void print_table(const std::vector<Report>& reports, const Options& options) {
   std::printf("%-24s %6s", "run", "f_th");
   for (const double tol : options.tolerances) std::printf("   P@%.0f%%   R@%.0f%%   F@%.0f%%", tol * 100, tol * 100, tol * 100);
-  std::printf("  segs/step  gt/step  ids  life_mean_ms life_max_ms\n");
+  std::printf("  segs/step  gt/step  gt_steps  no_pred  ids  life_mean_ms life_max_ms\n");
   for (const Report& r : reports) {
     if (r.threshold) {
       std::printf("%-24s %6.3f", r.label.c_str(), static_cast<double>(*r.threshold));
     } else {
       std::printf("%-24s %6s", r.label.c_str(), "-");
     }
-    for (const Prf& p : r.summed) std::printf("  %6.3f  %6.3f  %6.3f", p.precision, p.recall, p.f);
-    std::printf("  %9.1f  %7.1f  %4llu  %11.1f %11.1f\n", r.mean_predicted, r.mean_ground_truth,
+    for (const Prf& p : r.summed) std::printf("  %6s  %6s  %6s", figure(p.precision).c_str(), figure(p.recall).c_str(), figure(p.f).c_str());
+    std::printf("  %9.1f  %7.1f  %8llu  %7llu  %4llu  %11.1f %11.1f\n", r.mean_predicted, r.mean_ground_truth,
+                static_cast<unsigned long long>(r.coverage.ground_truth_steps),
+                static_cast<unsigned long long>(r.coverage.steps_without_prediction),
                 static_cast<unsigned long long>(r.lifetime.count), r.lifetime.mean_ms, r.lifetime.max_ms);
   }
 }
@@ -115,6 +156,12 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
       json.null();
     }
     json.key("steps").value(r.steps).key("events").value(r.events).key("scene_seconds").value(r.scene_seconds);
+    json.key("coverage").begin_object().key("ground_truth_steps").value(r.coverage.ground_truth_steps);
+    json.key("steps_without_prediction").value(r.coverage.steps_without_prediction);
+    json.key("prediction_hold_us").value(static_cast<std::int64_t>(r.hold_us));
+    json.key("predicted_steps").value(r.coverage.predicted_steps);
+    json.key("predicted_steps_scored").value(r.coverage.predicted_steps_scored);
+    json.key("predicted_steps_outside_ground_truth").value(r.coverage.predicted_steps_outside).end_object();
     json.key("wall_seconds").value(r.wall_seconds);
     json.key("accuracy").begin_array();
     for (std::size_t i = 0; i < r.summed.size(); ++i) {
@@ -135,7 +182,7 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
 
 int run(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim) {
   std::vector<Report> reports;
-  std::optional<StepEvaluator> last;
+  std::optional<StreamEvaluator> last;
   if (!options.segments.empty()) {
     if (options.ground_truth.empty() == !sim.scene_selected()) {
       spdlog::error("with --segments give the ground truth: --ground-truth FILE or --scene NAME");
@@ -149,6 +196,11 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     last.emplace(evaluate_files(options, *sensor, sim));
     reports.push_back(make_report(*last));
     reports.back().label = options.segments.filename().string();
+    const StepCoverage& c = last->coverage();
+    spdlog::info("{} ground-truth steps scored, {} of them with no prediction within {:.1f} ms; {} predicted steps, {} "
+                 "scored, {} outside the ground truth's time range (not scored)",
+                 c.ground_truth_steps, c.steps_without_prediction, static_cast<double>(last->hold_us()) * 1e-3,
+                 c.predicted_steps, c.predicted_steps_scored, c.predicted_steps_outside);
   } else {
     if (!sim.scene_selected()) {
       spdlog::error("give --segments FILE, or --scene NAME to run the pipeline on a built-in scene");
@@ -162,7 +214,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       PipelineConfig config = base;
       config.score.fit_threshold = threshold;
       const auto started = std::chrono::steady_clock::now();
-      last.emplace(scene.sensor, options.tolerances);
+      last.emplace(make_scene_evaluator(scene, options.tolerances, options.step_us));
       const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last);
       Report r = make_report(*last);
       r.label = scene.name;
@@ -194,7 +246,9 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
 int main(int argc, char** argv) {
   CLI::App app{"evldt-eval: line heat-map precision/recall/F (pixels matched one-to-one within a tolerance of the\n"
                "image diagonal, counts summed over steps) and segment lifetimes. Either score a segment CSV\n"
-               "against --ground-truth CSV or a --scene, or run the pipeline on --scene (with --pr-thresholds, once per f_th)."};
+               "against --ground-truth CSV or a --scene, or run the pipeline on --scene (with --pr-thresholds, once per f_th).\n"
+               "Every ground-truth step is scored, against the latest predicted step at or before it within 1.5 output\n"
+               "periods, else against nothing (its ground truth counts as missed). Undefined figures print n/a."};
   Options options;
   PipelineOptions pipeline_options;
   SimulatorOptions sim_options;
@@ -206,9 +260,12 @@ int main(int argc, char** argv) {
   app.add_option("--tolerance", options.tolerances, "Match tolerances as fractions of the diagonal")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.0001, 0.5));
-  app.add_option("--step-us", options.step_us, "Scene runs: event time between scored steps")
+  app.add_option("--step-us", options.step_us, "With --scene: event time between ground-truth steps (and pipeline outputs)")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{100}, Timestamp{10'000'000}));
+  app.add_option("--output-period-us", options.output_period_us,
+                 "Output period of --segments (default: its median step spacing); a predicted step is held for 1.5 periods")
+      ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
   app.add_option("--pr-thresholds", options.pr_thresholds, "Scene runs: f_th values for a PR curve")
       ->check(finite_number() & CLI::Range(0.0, 1.0));
   app.add_option("--json", options.json, "Write the results as JSON");

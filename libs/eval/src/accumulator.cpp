@@ -10,8 +10,7 @@ namespace evldt {
 
 EvaluationAccumulator::EvaluationAccumulator(std::vector<double> tolerance_fractions)
     : tolerance_fractions_(std::move(tolerance_fractions)),
-      totals_(tolerance_fractions_.size()),
-      step_prf_(tolerance_fractions_.size()) {
+      totals_(tolerance_fractions_.size()) {
   if (tolerance_fractions_.empty()) throw std::invalid_argument("an evaluation needs at least one tolerance");
 }
 
@@ -21,26 +20,10 @@ void EvaluationAccumulator::add_step(std::span<const MatchCounts> counts, std::s
     throw std::invalid_argument("step has counts for " + std::to_string(counts.size()) + " tolerances, expected " +
                                 std::to_string(tolerance_fractions_.size()));
   }
-  for (std::size_t i = 0; i < counts.size(); ++i) {
-    totals_[i] += counts[i];
-    step_prf_[i].push_back(prf(counts[i]));
-  }
+  for (std::size_t i = 0; i < counts.size(); ++i) totals_[i] += counts[i];
   ++steps_;
   predicted_segments_ += predicted_segments;
   ground_truth_segments_ += ground_truth_segments;
-}
-
-Prf EvaluationAccumulator::mean_step_prf(std::size_t i) const {
-  const std::vector<Prf>& steps = step_prf_.at(i);
-  if (steps.empty()) return prf(MatchCounts{});
-  Prf mean;
-  for (const Prf& step : steps) {
-    mean.precision += step.precision;
-    mean.recall += step.recall;
-    mean.f += step.f;
-  }
-  const auto n = static_cast<double>(steps.size());
-  return {mean.precision / n, mean.recall / n, mean.f / n};
 }
 
 double EvaluationAccumulator::mean_predicted_segments() const {

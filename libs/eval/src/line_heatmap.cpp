@@ -85,14 +85,12 @@ void rasterise(std::span<const Segment> segments, SensorSize sensor, std::vector
 }
 
 Prf prf(const MatchCounts& counts) {
-  Prf result;
-  result.precision =
-      counts.predicted == 0 ? 1.0 : static_cast<double>(counts.matched) / static_cast<double>(counts.predicted);
-  result.recall =
-      counts.ground_truth == 0 ? 1.0 : static_cast<double>(counts.matched) / static_cast<double>(counts.ground_truth);
-  const double sum = result.precision + result.recall;
-  result.f = sum == 0 ? 0.0 : 2.0 * result.precision * result.recall / sum;
-  return result;
+  const auto ratio = [](std::uint64_t numerator, std::uint64_t denominator) {
+    return denominator == 0 ? std::numeric_limits<double>::quiet_NaN()
+                            : static_cast<double>(numerator) / static_cast<double>(denominator);
+  };
+  return {ratio(counts.matched, counts.predicted), ratio(counts.matched, counts.ground_truth),
+          ratio(2 * counts.matched, counts.predicted + counts.ground_truth)};
 }
 
 double diagonal_tolerance_px(SensorSize sensor, double tolerance_fraction) {

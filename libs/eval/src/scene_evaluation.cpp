@@ -1,29 +1,110 @@
 #include "evldt/eval/scene_evaluation.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <stdexcept>
+
 #include "evldt/events/event_validator.hpp"
 
 namespace evldt {
 
-StepEvaluator::StepEvaluator(SensorSize sensor, std::vector<double> tolerance_fractions)
-    : accuracy_(tolerance_fractions), counts_(tolerance_fractions.size()) {
+GroundTruthSteps scene_ground_truth_steps(const Scene& scene, Timestamp step_us) {
+  if (step_us <= 0) throw std::invalid_argument("ground-truth step must be positive");
+  GroundTruthSteps steps;
+  for (Timestamp t = 0; t <= scene.duration_us; t += step_us) steps.times.push_back(t);
+  steps.segments_at = [scene = std::make_shared<const Scene>(scene), times = steps.times](std::size_t index,
+                                                                                          std::vector<Segment>& out) {
+    out.clear();
+    for (const GtSegment& g : scene->visible_edges(times.at(index))) out.push_back({g.a.cast<float>(), g.b.cast<float>()});
+  };
+  return steps;
+}
+
+GroundTruthSteps csv_ground_truth_steps(const std::vector<GroundTruthRow>& rows) {
+  auto by_time = std::make_shared<std::map<Timestamp, std::vector<Segment>>>();
+  for (const GroundTruthRow& row : rows) {
+    (*by_time)[row.t_us].push_back({row.segment.a.cast<float>(), row.segment.b.cast<float>()});
+  }
+  GroundTruthSteps steps;
+  for (const auto& [t, segments] : *by_time) steps.times.push_back(t);
+  steps.segments_at = [by_time, times = steps.times](std::size_t index, std::vector<Segment>& out) {
+    out = by_time->at(times.at(index));
+  };
+  return steps;
+}
+
+Timestamp median_step_spacing(std::span<const Timestamp> sorted_times) {
+  std::vector<Timestamp> gaps;
+  for (std::size_t i = 1; i < sorted_times.size(); ++i) {
+    if (sorted_times[i] > sorted_times[i - 1]) gaps.push_back(sorted_times[i] - sorted_times[i - 1]);
+  }
+  if (gaps.empty()) return 0;
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+  return gaps[gaps.size() / 2];
+}
+
+StreamEvaluator::StreamEvaluator(SensorSize sensor, std::vector<double> tolerance_fractions,
+                                 GroundTruthSteps ground_truth, Timestamp hold_us)
+    : accuracy_(tolerance_fractions),
+      ground_truth_(std::move(ground_truth)),
+      hold_us_(hold_us),
+      counts_(tolerance_fractions.size()) {
+  if (hold_us_ < 0) throw std::invalid_argument("the hold of a prediction must not be negative");
+  if (!std::is_sorted(ground_truth_.times.begin(), ground_truth_.times.end()) ||
+      std::adjacent_find(ground_truth_.times.begin(), ground_truth_.times.end()) != ground_truth_.times.end()) {
+    throw std::invalid_argument("ground-truth step times must increase");
+  }
   for (const double fraction : tolerance_fractions) matchers_.emplace_back(sensor, fraction);
+  coverage_.ground_truth_steps = ground_truth_.times.size();
 }
 
-void StepEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted,
-                             std::span<const Segment> ground_truth) {
-  for (std::size_t i = 0; i < matchers_.size(); ++i) counts_[i] = matchers_[i].match(predicted, ground_truth);
-  accuracy_.add_step(counts_, predicted.size(), ground_truth.size());
+void StreamEvaluator::score_steps_before(Timestamp until) {
+  const std::vector<Timestamp>& times = ground_truth_.times;
+  for (; next_step_ < times.size() && times[next_step_] < until; ++next_step_) {
+    const bool use_held = holding_ && times[next_step_] - held_t_ <= hold_us_;
+    const std::span<const Segment> predicted = use_held ? std::span<const Segment>(held_) : std::span<const Segment>();
+    held_scored_ = held_scored_ || use_held;
+    coverage_.steps_without_prediction += use_held ? 0 : 1;
+    ground_truth_.segments_at(next_step_, truth_);
+    for (std::size_t i = 0; i < matchers_.size(); ++i) counts_[i] = matchers_[i].match(predicted, truth_);
+    accuracy_.add_step(counts_, predicted.size(), truth_.size());
+  }
+}
+
+void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted) {
+  if (finished_) throw std::logic_error("prediction added after finish()");
+  if (holding_ && t < held_t_) throw std::invalid_argument("predicted steps must not go back in time");
   lifetimes_.observe_step(t, ids);
+  if (!holding_ || t > held_t_) {
+    score_steps_before(t);
+    coverage_.predicted_steps_scored += held_scored_ ? 1 : 0;
+    held_scored_ = false;
+    ++coverage_.predicted_steps;
+    const std::vector<Timestamp>& times = ground_truth_.times;
+    if (times.empty() || t > times.back() || t < times.front() - hold_us_) ++coverage_.predicted_steps_outside;
+  }
+  holding_ = true;
+  held_t_ = t;
+  held_.assign(predicted.begin(), predicted.end());
 }
 
-std::vector<Segment> scene_ground_truth(const Scene& scene, Timestamp t) {
-  std::vector<Segment> out;
-  for (const GtSegment& g : scene.visible_edges(t)) out.push_back({g.a.cast<float>(), g.b.cast<float>()});
-  return out;
+void StreamEvaluator::finish() {
+  if (finished_) throw std::logic_error("finish() called twice");
+  finished_ = true;
+  score_steps_before(std::numeric_limits<Timestamp>::max());
+  coverage_.predicted_steps_scored += held_scored_ ? 1 : 0;
+}
+
+StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tolerance_fractions, Timestamp step_us) {
+  return StreamEvaluator(scene.sensor, std::move(tolerance_fractions), scene_ground_truth_steps(scene, step_us),
+                         std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(step_us)));
 }
 
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
-                              Timestamp step_us, StepEvaluator& evaluator) {
+                              Timestamp step_us, StreamEvaluator& evaluator) {
   EventSimulator simulator(scene, sim);
   EventValidator validator(scene.sensor, 0);
   DeterministicPipeline pipeline(config);
@@ -36,7 +117,7 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
       ids.push_back(line.id);
       predicted.push_back(line.segment);
     }
-    evaluator.add_step(t, ids, predicted, scene_ground_truth(scene, t));
+    evaluator.add_prediction(t, ids, predicted);
   });
   SceneRunResult result;
   EventBatch batch;
@@ -48,6 +129,7 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
     pipeline.process(batch);
     if (!more) break;
   }
+  evaluator.finish();
   result.scene_seconds = static_cast<double>(scene.duration_us) * 1e-6;
   result.counters = pipeline.counters();
   return result;

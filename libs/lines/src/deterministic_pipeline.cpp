@@ -24,11 +24,21 @@ void DeterministicPipeline::set_output(Timestamp period_us, StepCallback on_step
   if (started_) update_next_due();
 }
 
+namespace {
+// The first multiple of `period` after t (floor division: event times may be negative).
+Timestamp first_multiple_after(Timestamp t, Timestamp period) {
+  const Timestamp periods = t / period - (t % period < 0 ? 1 : 0);
+  return (periods + 1) * period;
+}
+}  // namespace
+
 void DeterministicPipeline::start(Timestamp t0) {
+  // Every schedule runs on multiples of its period, so an output step is taken right after the
+  // rounds of its time and falls on the grid ground truth is sampled on.
   started_ = true;
-  next_track_ = t0 + config_.schedule.track_period_us;
-  next_detect_ = t0 + config_.schedule.detect_period_us;
-  next_output_ = t0 + output_period_;
+  next_track_ = first_multiple_after(t0, config_.schedule.track_period_us);
+  next_detect_ = first_multiple_after(t0, config_.schedule.detect_period_us);
+  if (output_period_ > 0) next_output_ = first_multiple_after(t0, output_period_);
   update_next_due();
 }
 

@@ -116,9 +116,11 @@ void LinesNode::publish_loop(const std::atomic<bool>& stop) {
     if (options_.log_period_s > 0 && now - last_log >= std::chrono::duration<double>(options_.log_period_s)) {
       last_log = now;
       const LinesNodeTotals t = totals();
-      spdlog::info("{} events stored, {} batches ({} lost, {} invalid messages), {} lines created, {} lists published",
+      spdlog::info("{} events stored, {} batches ({} lost, {} invalid messages), {} lines created, {} lists published, "
+                   "latency {:.1f} / {:.1f} ms (median / p99 of the last statistics period)",
                    t.events_stored, t.receiver.sequence.received, t.receiver.sequence.lost,
-                   t.receiver.invalid_messages, t.lines_created, t.lists_published);
+                   t.receiver.invalid_messages, t.lines_created, t.lists_published, last_latency_.median_ms,
+                   last_latency_.p99_ms);
     }
     next_publish += publish_period;
     if (next_publish < now) next_publish = now;  // fell behind: do not burst to catch up
@@ -181,6 +183,7 @@ void LinesNode::publish_stats(double period_s) {
   msg.latency_p99_ms = static_cast<float>(latency.p99_ms);
   lcm_.publish(std::string(kStatsChannel), &msg);
   last_stats_ = now;
+  last_latency_ = latency;
 }
 
 LinesNodeTotals LinesNode::totals() const {

@@ -12,9 +12,8 @@
 
 namespace evldt {
 
-/// Collects the MatchCounts of each evaluation step at several tolerances. The headline figure is
-/// the Prf of the counts summed over all steps (every pixel weighs the same, as in the benchmarks);
-/// the mean of the per-step Prf is kept beside it because it weighs every step the same instead.
+/// Collects the MatchCounts of each evaluation step at several tolerances. The figure is the Prf of
+/// the counts summed over all steps (every pixel weighs the same, as in the benchmarks).
 class EvaluationAccumulator {
  public:
   /// Tolerances as fractions of the image diagonal; throws std::invalid_argument if empty.
@@ -28,12 +27,8 @@ class EvaluationAccumulator {
   [[nodiscard]] std::uint64_t steps() const { return steps_; }
   /// Counts summed over all steps at tolerance index i.
   [[nodiscard]] const MatchCounts& total(std::size_t i) const { return totals_.at(i); }
-  /// Prf of total(i); with no step that is prf({}) = 1/1/1.
+  /// Prf of total(i) (undefined parts are NaN: see prf()).
   [[nodiscard]] Prf summed_prf(std::size_t i) const { return prf(totals_.at(i)); }
-  /// Each step's Prf at tolerance index i, in the order added.
-  [[nodiscard]] std::span<const Prf> step_prf(std::size_t i) const { return step_prf_.at(i); }
-  /// Mean over steps of precision, of recall and of F, each on its own; with no step, prf({}).
-  [[nodiscard]] Prf mean_step_prf(std::size_t i) const;
   /// Mean number of segments per step (0 with no step).
   [[nodiscard]] double mean_predicted_segments() const;
   [[nodiscard]] double mean_ground_truth_segments() const;
@@ -41,7 +36,6 @@ class EvaluationAccumulator {
  private:
   std::vector<double> tolerance_fractions_;
   std::vector<MatchCounts> totals_;
-  std::vector<std::vector<Prf>> step_prf_;
   std::uint64_t steps_ = 0;
   std::uint64_t predicted_segments_ = 0;
   std::uint64_t ground_truth_segments_ = 0;

@@ -42,11 +42,11 @@ struct Prf {
   double f = 0;
 };
 
-/// precision = matched / predicted, recall = matched / ground_truth, F = 2PR / (P + R).
-/// Empty denominators follow "nothing claimed is nothing wrong, nothing to find is nothing missed":
-/// precision of 0 predicted pixels is 1, recall of 0 ground-truth pixels is 1, and F is 0 when
-/// P + R = 0. So an empty prediction of an empty scene scores 1/1/1, predictions on an empty scene
-/// 0/1/0, and no prediction on a non-empty scene 1/0/0.
+/// precision = matched / predicted, recall = matched / ground_truth, F = 2PR / (P + R), which is
+/// 2 matched / (predicted + ground_truth). What has an empty denominator is undefined, NaN (reported
+/// as "n/a" and JSON null): precision of no predicted pixel, recall of no ground-truth pixel, F when
+/// both are empty. So an empty prediction of a non-empty scene scores n/a / 0 / 0, predictions on
+/// an empty scene 0 / n/a / 0: nothing predicted is never a perfect score.
 [[nodiscard]] Prf prf(const MatchCounts& counts);
 
 /// The matching radius in px: fraction of the image diagonal hypot(W, H).

@@ -1,7 +1,9 @@
 #pragma once
-// Scoring a stream of predicted segments against ground truth, step by step: the heat-map counts at
-// each tolerance, and the lifetime of every predicted id.
+// Scoring a stream of predicted segments against ground truth over the ground truth's time range:
+// every ground-truth step is scored (heat-map counts at each tolerance), whatever the prediction
+// covers, and the lifetime of every predicted id is followed.
 
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -9,24 +11,80 @@
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/sim/event_simulator.hpp"
+#include "evldt/sim/ground_truth_csv.hpp"
 
 namespace evldt {
 
-class StepEvaluator {
+/// The times at which ground truth is known, and its segments at each.
+struct GroundTruthSteps {
+  std::vector<Timestamp> times;  ///< strictly increasing
+  /// Fills `out` with the segments of step `index` (an index into `times`).
+  std::function<void(std::size_t index, std::vector<Segment>& out)> segments_at;
+};
+
+/// A scene's exact visible edges at t = 0, step_us, 2 step_us, ... up to its duration (the steps
+/// evldt-sim writes with --gt-period-us = step_us).
+GroundTruthSteps scene_ground_truth_steps(const Scene& scene, Timestamp step_us);
+/// The steps of a ground-truth CSV: each distinct time of its rows. (A step with no visible edge
+/// has no row, so it cannot be a step here.)
+GroundTruthSteps csv_ground_truth_steps(const std::vector<GroundTruthRow>& rows);
+
+/// How a prediction stream lined up with the ground-truth steps.
+struct StepCoverage {
+  std::uint64_t ground_truth_steps = 0;
+  std::uint64_t steps_without_prediction = 0;  ///< scored against an empty prediction
+  std::uint64_t predicted_steps = 0;           ///< distinct times of the prediction
+  std::uint64_t predicted_steps_scored = 0;    ///< used by at least one ground-truth step
+  std::uint64_t predicted_steps_outside = 0;   ///< after the last ground-truth step or before the first one's reach
+};
+
+/// The rule: ground-truth step t is scored against the latest predicted step p <= t when t - p <=
+/// hold_us, and against an empty prediction otherwise (all of its ground truth counts as missed).
+/// hold_us is one output period with half a period of slack for jitter (kHoldPeriods), so a method
+/// that outputs nothing for a while, or a live system that stalls, loses that time's recall, while
+/// a prediction that lags by up to one period is scored as it stands. Predicted steps later than the
+/// last ground-truth step, or earlier than the first by more than hold_us, are counted, not scored.
+/// Every predicted step counts towards the lifetimes of its ids.
+class StreamEvaluator {
  public:
-  StepEvaluator(SensorSize sensor, std::vector<double> tolerance_fractions);
-  /// One output step: predicted (id, segment) pairs against the ground-truth segments of that time.
-  void add_step(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted,
-                std::span<const Segment> ground_truth);
+  static constexpr double kHoldPeriods = 1.5;
+  StreamEvaluator(SensorSize sensor, std::vector<double> tolerance_fractions, GroundTruthSteps ground_truth,
+                  Timestamp hold_us);
+  /// One predicted step; times must not decrease (throws std::invalid_argument), and a step at the
+  /// time of the previous one replaces it.
+  void add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted);
+  /// Scores the ground-truth steps after the last prediction; call once, after the last add_prediction.
+  void finish();
+
   [[nodiscard]] const EvaluationAccumulator& accuracy() const { return accuracy_; }
   [[nodiscard]] const LifetimeTracker& lifetimes() const { return lifetimes_; }
+  [[nodiscard]] const StepCoverage& coverage() const { return coverage_; }
+  [[nodiscard]] Timestamp hold_us() const { return hold_us_; }
+  [[nodiscard]] const GroundTruthSteps& ground_truth() const { return ground_truth_; }
 
  private:
+  /// Scores every ground-truth step before `until` against the held prediction.
+  void score_steps_before(Timestamp until);
+
   std::vector<HeatmapMatcher> matchers_;
   EvaluationAccumulator accuracy_;
   LifetimeTracker lifetimes_;
+  GroundTruthSteps ground_truth_;
+  Timestamp hold_us_;
+  std::size_t next_step_ = 0;
+  bool holding_ = false;
+  bool held_scored_ = false;
+  Timestamp held_t_ = 0;
+  std::vector<Segment> held_;
+  std::vector<Segment> truth_;
   std::vector<MatchCounts> counts_;
+  StepCoverage coverage_;
+  bool finished_ = false;
 };
+
+/// The nominal output period of a prediction: the median spacing of its distinct step times, or 0
+/// with fewer than two.
+Timestamp median_step_spacing(std::span<const Timestamp> sorted_times);
 
 struct SceneRunResult {
   std::uint64_t events = 0;
@@ -34,12 +92,13 @@ struct SceneRunResult {
   PipelineCounters counters;
 };
 
-/// Simulates the scene, runs the deterministic pipeline on it and scores every output step against
-/// the scene's exact visible edges.
+/// Simulates the scene, runs the deterministic pipeline on it with an output every step_us and scores
+/// it on the scene's ground-truth steps (scene_ground_truth_steps) with a hold of
+/// kHoldPeriods * step_us. `evaluator` must have been made for those steps.
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
-                              Timestamp step_us, StepEvaluator& evaluator);
+                              Timestamp step_us, StreamEvaluator& evaluator);
 
-/// Ground-truth segments of a scene at time t, as float segments.
-std::vector<Segment> scene_ground_truth(const Scene& scene, Timestamp t);
+/// The evaluator evaluate_scene expects for a scene.
+StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tolerance_fractions, Timestamp step_us);
 
 }  // namespace evldt

@@ -29,7 +29,8 @@ class DeterministicPipeline {
 
   explicit DeterministicPipeline(const PipelineConfig& config, bool keep_surface = false);
 
-  /// Adds an output step every period_us of event time (0 disables it).
+  /// Adds an output step at every multiple of period_us of event time after the first event (0
+  /// disables it): the steps fall on the same clock grid as ground truth sampled every period_us.
   void set_output(Timestamp period_us, StepCallback on_step);
 
   /// Feeds on-sensor events in time order (an EventValidator upstream guarantees both). A round due

@@ -85,6 +85,7 @@ class LinesNode {
   std::int64_t list_seq_ = 0;
   std::atomic<std::uint64_t> lists_published_{0};
   LinesNodeTotals last_stats_;
+  LatencySummary last_latency_;  ///< of the last statistics message, for the log line
 };
 
 }  // namespace evldt
