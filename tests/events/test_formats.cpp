@@ -484,36 +484,55 @@ TEST(Corrupt, DatCutInTheMiddleKeepsTheWholeRecordsBeforeIt) {
   EXPECT_EQ(result.error->byte_offset(), data_start + 8 * 37);
 }
 
-TEST(Corrupt, ReservedEvt2TypeIsAnErrorAtItsWord) {
-  auto bytes = bytes_of("% evt 2.0\n% end\n");  // 16 bytes
+// Reserved word types are skipped and counted, as the vendor SDK skips them: some cameras pad their
+// streams with them, and no single word can stop a stream.
+TEST(RawQuirks, ReservedEvt2TypesAreSkippedAndCountedTriggersCounted) {
+  auto bytes = bytes_of("% evt 2.0\n% end\n");
   append_le32(bytes, (0x1u << 28) | (1u << 11) | 1u);
   append_le32(bytes, 0x20000000u);  // type 0x2 is reserved
+  append_le32(bytes, 0xA0000001u);  // an external trigger
+  append_le32(bytes, 0xD1234567u);  // type 0xD is reserved
   append_le32(bytes, (0x1u << 28) | (2u << 11) | 2u);
   EventBatch batch;
   const auto decoder = make_decoder(EventFormat::Evt2, "cam.raw");
-  const FormatError error = expect_format_error([&] { decoder->decode(bytes, batch); });
-  EXPECT_EQ(events_of(batch), (std::vector<Event>{{0, 1, 1, 1}}));
-  EXPECT_EQ(error.byte_offset(), 20u);
-  EXPECT_NE(std::string(error.what()).find("reserved"), std::string::npos);
+  decoder->decode(bytes, batch);
+  decoder->finish(batch);
+  EXPECT_EQ(events_of(batch), (std::vector<Event>{{0, 1, 1, 1}, {0, 2, 2, 1}}));
+  EXPECT_EQ(decoder->counts(), (DecodeCounts{2, 1}));
 }
 
-TEST(Corrupt, ReservedEvt3TypesAreErrorsThatTheReaderDeliversAfterTheEvents) {
+TEST(RawQuirks, Evt3PaddingAndReservedWordsAreSkippedAndCountedInAnyChunking) {
   TempDir dir;
-  const fs::path path = dir.file("reserved.raw");
-  for (const std::uint16_t reserved : std::initializer_list<std::uint16_t>{0x1000, 0x9000, 0xB000, 0xC000, 0xD000}) {
-    SCOPED_TRACE(reserved);
-    auto bytes = bytes_of("% evt 3.0\n% end\n");  // 16 bytes
-    for (const std::uint16_t word : {std::uint16_t{0x8000}, std::uint16_t{0x0003}, std::uint16_t{0x2804}, reserved,
-                                     std::uint16_t{0x2805}}) {
-      append_le16(bytes, word);
-    }
-    write_bytes(path, bytes);
-    const ReadResult result = read_file(path, std::nullopt, 3);
-    EXPECT_EQ(result.events, (std::vector<Event>{{0, 4, 3, 1}}));
-    ASSERT_TRUE(result.error);
-    EXPECT_EQ(result.error->byte_offset(), 22u);
-    EXPECT_TRUE(result.ended_after_error);
+  const fs::path path = dir.file("padded.raw");
+  auto bytes = bytes_of("% evt 3.0\n% end\n");
+  // TIME_HIGH 0, y 3, x 4, then IMX636-style 0x9999 padding and the other reserved types, a
+  // trigger, and x 5.
+  for (const std::uint16_t word : {0x8000, 0x0003, 0x2804, 0x9999, 0x9999, 0x1000, 0xB000, 0xC000, 0xD000, 0xA001, 0x2805}) {
+    append_le16(bytes, word);
   }
+  write_bytes(path, bytes);
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{3}, kOneMiB}) {
+    SCOPED_TRACE(chunk);
+    EventFileReader reader(path, std::nullopt, chunk);
+    EventBatch batch, all;
+    while (reader.read(batch)) {
+      for (std::size_t i = 0; i < batch.size(); ++i) all.push_back(batch[i]);
+    }
+    EXPECT_EQ(events_of(all), (std::vector<Event>{{0, 4, 3, 1}, {0, 5, 3, 1}}));
+    EXPECT_EQ(reader.counts(), (DecodeCounts{6, 1}));
+  }
+}
+
+TEST(RawQuirks, BareWordsHaveNoHeaderEvenWhenTheyStartWithAPercentByte) {
+  // 0x0025 is EVT_ADDR_Y 37, whose first byte is '%'.
+  std::vector<std::uint8_t> bytes;
+  for (const std::uint16_t word : {0x8000, 0x0025, 0x2804}) append_le16(bytes, word);
+  bytes.insert(bytes.begin(), {0x25, 0x00});  // y = 37 first
+  EventBatch batch;
+  const auto decoder = detail::make_evt3_decoder("packet", RawFraming::BareWords);
+  decoder->decode(bytes, batch);
+  decoder->finish(batch);
+  EXPECT_EQ(events_of(batch), (std::vector<Event>{{0, 4, 37, 1}}));
 }
 
 TEST(Corrupt, DatWithWrongEventSizeOrTypeIsRefused) {

@@ -42,6 +42,10 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
   std::fprintf(out, "  events           %" PRIu64 " read, %" PRIu64 " processed, %" PRIu64 " dropped (%" PRIu64
                " off-sensor, %" PRIu64 " time-backwards), %" PRIu64 " clock resets\n",
                events_read, counters.events, drops.total(), drops.off_sensor, drops.time_backwards, drops.clock_resets);
+  if (decoded.skipped_words > 0 || decoded.trigger_events > 0) {
+    std::fprintf(out, "  decoding         %" PRIu64 " words of reserved or unknown types skipped, %" PRIu64 " trigger events\n",
+                 decoded.skipped_words, decoded.trigger_events);
+  }
   std::fprintf(out, "  event time       %.3f s (%.2f Mev/s)\n", event_seconds, event_seconds > 0 ? mev / event_seconds : 0.0);
   std::fprintf(out, "  wall time        %.3f s (%.2f Mev/s processed)\n", wall_seconds, wall_seconds > 0 ? mev / wall_seconds : 0.0);
   std::fprintf(out,
@@ -68,6 +72,7 @@ void RunSummary::write_json(const std::filesystem::path& path) const {
   out << "  \"events_read\": " << events_read << ",\n  \"events_processed\": " << counters.events << ",\n";
   out << "  \"dropped_off_sensor\": " << drops.off_sensor << ",\n  \"dropped_time_backwards\": " << drops.time_backwards << ",\n";
   out << "  \"clock_resets\": " << drops.clock_resets << ",\n";
+  out << "  \"skipped_words\": " << decoded.skipped_words << ",\n  \"trigger_events\": " << decoded.trigger_events << ",\n";
   out << "  \"event_seconds\": " << event_seconds << ",\n  \"wall_seconds\": " << wall_seconds << ",\n";
   out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds << ",\n";
   out << "  \"skipped_rounds\": " << counters.skipped_rounds << ",\n";

@@ -126,6 +126,62 @@ void PercentHeader::finish(const std::string& source) const {
   if (in_line_) throw FormatError(source, line_start_, "file ends inside a header line");
 }
 
+namespace {
+
+// Prophesee cameras whose RAW headers (2020-era SDK) name no geometry or format: the vendor tools
+// know the sensor from "% system_ID" (decimal), as OpenEB's device_system_id.h and raw file header
+// do, and older tools from "% plugin_name".
+struct KnownSystem {
+  int system_id;
+  const char* encoding;
+  SensorSize sensor;
+};
+constexpr SensorSize kVga{640, 480};
+constexpr SensorSize kHd{1280, 720};
+constexpr KnownSystem kKnownSystems[] = {
+    {0x15, "EVT2", kVga}, {0x17, "EVT2", kVga}, {0x97, "EVT2", kVga}, {0x19, "EVT2", kVga},  // Gen3.0
+    {0x99, "EVT2", kVga}, {0x1D, "EVT2", kVga}, {0x21, "EVT2", kVga}, {0xA1, "EVT2", kVga},
+    {0x1C, "EVT2", kVga}, {0x22, "EVT2", kVga}, {0xA2, "EVT2", kVga}, {0x23, "EVT2", kVga},  // Gen3.1
+    {0x29, "EVT2", kVga}, {0x28, "EVT3", kVga},
+    {0x1A, "EVT2", kHd},  {0x1F, "EVT2", kHd},  {0x1E, "EVT3", kHd},  {0x2E, "EVT3", kHd},  // Gen4.0
+    {0x27, "EVT2", kHd},  {0x30, "EVT3", kHd},                                              // Gen4.1
+    {0x31, "EVT3", kHd},  {0x32, "EVT3", kHd},                                              // IMX636
+};
+struct KnownPlugin {
+  const char* name;
+  SensorSize sensor;
+};
+constexpr KnownPlugin kKnownPlugins[] = {
+    {"hal_plugin_gen3_fx3", kVga},   {"hal_plugin_gen31_fx3", kVga},  {"hal_plugin_gen31_evk2", kVga},
+    {"hal_plugin_gen31_evk3", kVga}, {"hal_plugin_gen4_fx3", kHd},    {"hal_plugin_gen4_evk2", kHd},
+    {"hal_plugin_gen41_evk2", kHd},  {"hal_plugin_gen41_evk3", kHd},
+};
+
+const KnownSystem* known_system(const std::vector<std::string>& lines) {
+  for (const std::string& line : lines) {
+    const auto [key, value] = split_header_line(line);
+    if (!equals_ignoring_case(key, "system_ID")) continue;
+    const auto id = parse_positive_int(value);
+    for (const KnownSystem& system : kKnownSystems) {
+      if (id && system.system_id == *id) return &system;
+    }
+  }
+  return nullptr;
+}
+
+std::optional<SensorSize> known_plugin_sensor(const std::vector<std::string>& lines) {
+  for (const std::string& line : lines) {
+    const auto [key, value] = split_header_line(line);
+    if (!equals_ignoring_case(key, "plugin_name")) continue;
+    for (const KnownPlugin& plugin : kKnownPlugins) {
+      if (equals_ignoring_case(trim(value), plugin.name)) return plugin.sensor;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<SensorSize> PercentHeader::geometry() const {
   std::optional<SensorSize> from_geometry;
   std::optional<SensorSize> from_format;
@@ -146,7 +202,8 @@ std::optional<SensorSize> PercentHeader::geometry() const {
   if (from_geometry) return from_geometry;
   if (from_format) return from_format;
   if (width && height) return SensorSize{*width, *height};
-  return std::nullopt;
+  if (const KnownSystem* system = known_system(lines_)) return system->sensor;
+  return known_plugin_sensor(lines_);
 }
 
 std::optional<std::string> PercentHeader::encoding() const {
@@ -162,7 +219,9 @@ std::optional<std::string> PercentHeader::encoding() const {
       from_evt_line = "EVT" + version;
     }
   }
-  return from_evt_line;
+  if (from_evt_line) return from_evt_line;
+  if (const KnownSystem* system = known_system(lines_)) return std::string(system->encoding);
+  return std::nullopt;
 }
 
 std::optional<EventFormat> raw_format_from_encoding(std::string_view encoding) {

@@ -9,8 +9,8 @@ namespace evldt {
 std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string source_name) {
   switch (format) {
     case EventFormat::EcdText: return detail::make_ecd_text_decoder(std::move(source_name));
-    case EventFormat::Evt2: return detail::make_evt2_decoder(std::move(source_name));
-    case EventFormat::Evt3: return detail::make_evt3_decoder(std::move(source_name));
+    case EventFormat::Evt2: return detail::make_evt2_decoder(std::move(source_name), RawFraming::WithHeader);
+    case EventFormat::Evt3: return detail::make_evt3_decoder(std::move(source_name), RawFraming::WithHeader);
     case EventFormat::Dat: return detail::make_dat_decoder(std::move(source_name));
   }
   throw std::invalid_argument("unknown event format");

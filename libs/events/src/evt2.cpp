@@ -1,9 +1,8 @@
 // Prophesee RAW EVT 2.0: a '%' text header, then little-endian 32-bit words whose top 4 bits are the type.
 //   CD_OFF 0x0 / CD_ON 0x1: [27:22] time bits 0..5, [21:11] x, [10:0] y
 //   EVT_TIME_HIGH 0x8:      [27:0] time bits 6..33
-//   EXT_TRIGGER 0xA, OTHERS 0xE, CONTINUED 0xF: not CD events, skipped; every other type is reserved.
-
-#include <cstdio>
+//   EXT_TRIGGER 0xA: counted. OTHERS 0xE, CONTINUED 0xF: not CD events, skipped.
+//   Every other type is reserved: skipped and counted, as the vendor SDK skips it.
 
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_writer.hpp"
@@ -31,21 +30,21 @@ constexpr Timestamp kMaxTimeHighStep = kTimeHighHalfRange - 1;
 
 class Evt2Decoder final : public EventDecoder {
  public:
-  explicit Evt2Decoder(std::string source) : source_(std::move(source)) {}
+  Evt2Decoder(std::string source, RawFraming framing) : source_(std::move(source)), bare_words_(framing == RawFraming::BareWords) {}
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
-    if (!header_.complete()) {
+    if (!bare_words_ && !header_.complete()) {
       const std::size_t used = header_.consume(chunk, source_);
       chunk = chunk.subspan(used);
       if (!header_.complete()) return;
       check_encoding();
       words_.set_offset(header_.size());
     }
-    words_.feed(chunk, [&](const std::uint8_t* bytes, std::uint64_t offset) { decode_word(load_le32(bytes), offset, out); });
+    words_.feed(chunk, [&](const std::uint8_t* bytes, std::uint64_t) { decode_word(load_le32(bytes), out); });
   }
 
   void finish(EventBatch& /*out*/) override {
-    header_.finish(source_);
+    if (!bare_words_) header_.finish(source_);
     if (words_.carried() > 0) {
       throw FormatError(source_, words_.offset(),
                         "file ends inside an EVT 2.0 word (" + std::to_string(words_.carried()) + " of 4 bytes)");
@@ -53,6 +52,7 @@ class Evt2Decoder final : public EventDecoder {
   }
 
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return header_.geometry(); }
+  [[nodiscard]] DecodeCounts counts() const override { return counts_; }
 
  private:
   void check_encoding() const {
@@ -62,7 +62,7 @@ class Evt2Decoder final : public EventDecoder {
     }
   }
 
-  void decode_word(std::uint32_t word, std::uint64_t offset, EventBatch& out) {
+  void decode_word(std::uint32_t word, EventBatch& out) {
     switch (word >> 28) {
       case kCdOff:
       case kCdOn:
@@ -76,19 +76,17 @@ class Evt2Decoder final : public EventDecoder {
         time_high_us_ = ((wraps_ << kTimeHighBits) + time_high) << kTimeLowBits;
         return;
       }
-      case kExtTrigger:
+      case kExtTrigger: ++counts_.trigger_events; return;
       case kOthers:
       case kContinued: return;
-      default: {
-        char reason[64];
-        std::snprintf(reason, sizeof(reason), "reserved EVT 2.0 word type 0x%X (word 0x%08X)", word >> 28, word);
-        throw FormatError(source_, offset, reason);
-      }
+      default: ++counts_.skipped_words; return;  // reserved: skipped as the vendor SDK does
     }
   }
 
   std::string source_;
+  bool bare_words_;
   PercentHeader header_;
+  DecodeCounts counts_;
   WordSplitter<4> words_;
   // Before the first TIME_HIGH the time high is 0.
   std::uint32_t last_time_high_ = 0;
@@ -134,8 +132,8 @@ class Evt2Encoder final : public EventEncoder {
 
 }  // namespace
 
-std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name) {
-  return std::make_unique<Evt2Decoder>(std::move(source_name));
+std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name, RawFraming framing) {
+  return std::make_unique<Evt2Decoder>(std::move(source_name), framing);
 }
 
 std::unique_ptr<EventEncoder> make_evt2_encoder(SensorSize sensor) {

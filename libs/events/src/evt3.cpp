@@ -7,13 +7,13 @@
 //   VECT_8 0x5:        [7:0] likewise, then base x += 8
 //   EVT_TIME_LOW 0x6:  [11:0] time bits 0..11
 //   EVT_TIME_HIGH 0x8: [11:0] time bits 12..23
-//   CONTINUED_4 0x7, EXT_TRIGGER 0xA, OTHERS 0xE, CONTINUED_12 0xF: not CD events, skipped.
-//   Every other type is reserved.
+//   EXT_TRIGGER 0xA: counted. CONTINUED_4 0x7, OTHERS 0xE, CONTINUED_12 0xF: not CD events, skipped.
+//   Every other type is reserved: skipped and counted, as the vendor SDK skips it (some IMX636
+//   cameras insert 0x9999 padding words), so no word can stop a stream.
 // Events before the first EVT_TIME_HIGH are dropped (their time is unknown), as Prophesee's decoder does;
 // that is not an error.
 
 #include <bit>
-#include <cstdio>
 
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_writer.hpp"
@@ -48,25 +48,26 @@ std::int8_t polarity_of(std::uint16_t word) { return (word & 0x800) != 0 ? std::
 
 class Evt3Decoder final : public EventDecoder {
  public:
-  explicit Evt3Decoder(std::string source) : source_(std::move(source)) {}
+  Evt3Decoder(std::string source, RawFraming framing) : source_(std::move(source)), bare_words_(framing == RawFraming::BareWords) {}
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
-    if (!header_.complete()) {
+    if (!bare_words_ && !header_.complete()) {
       const std::size_t used = header_.consume(chunk, source_);
       chunk = chunk.subspan(used);
       if (!header_.complete()) return;
       check_encoding();
       words_.set_offset(header_.size());
     }
-    words_.feed(chunk, [&](const std::uint8_t* bytes, std::uint64_t offset) { decode_word(load_le16(bytes), offset, out); });
+    words_.feed(chunk, [&](const std::uint8_t* bytes, std::uint64_t) { decode_word(load_le16(bytes), out); });
   }
 
   void finish(EventBatch& /*out*/) override {
-    header_.finish(source_);
+    if (!bare_words_) header_.finish(source_);
     if (words_.carried() > 0) throw FormatError(source_, words_.offset(), "file ends inside an EVT 3.0 word (1 of 2 bytes)");
   }
 
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return header_.geometry(); }
+  [[nodiscard]] DecodeCounts counts() const override { return counts_; }
 
  private:
   void check_encoding() const {
@@ -76,7 +77,7 @@ class Evt3Decoder final : public EventDecoder {
     }
   }
 
-  void decode_word(std::uint16_t word, std::uint64_t offset, EventBatch& out) {
+  void decode_word(std::uint16_t word, EventBatch& out) {
     switch (word >> 12) {
       case kAddrY: y_ = word & 0x7FF; return;
       case kAddrX:
@@ -98,15 +99,11 @@ class Evt3Decoder final : public EventDecoder {
         has_time_ = true;
         return;
       }
+      case kExtTrigger: ++counts_.trigger_events; return;
       case kContinued4:
-      case kExtTrigger:
       case kOthers:
       case kContinued12: return;
-      default: {
-        char reason[64];
-        std::snprintf(reason, sizeof(reason), "reserved EVT 3.0 word type 0x%X (word 0x%04X)", word >> 12, word);
-        throw FormatError(source_, offset, reason);
-      }
+      default: ++counts_.skipped_words; return;  // reserved, e.g. the 0x9999 padding of some IMX636 cameras
     }
   }
 
@@ -125,7 +122,9 @@ class Evt3Decoder final : public EventDecoder {
   }
 
   std::string source_;
+  bool bare_words_;
   PercentHeader header_;
+  DecodeCounts counts_;
   WordSplitter<2> words_;
   std::uint16_t y_ = 0;
   std::uint16_t base_x_ = 0;
@@ -189,8 +188,8 @@ class Evt3Encoder final : public EventEncoder {
 
 }  // namespace
 
-std::unique_ptr<EventDecoder> make_evt3_decoder(std::string source_name) {
-  return std::make_unique<Evt3Decoder>(std::move(source_name));
+std::unique_ptr<EventDecoder> make_evt3_decoder(std::string source_name, RawFraming framing) {
+  return std::make_unique<Evt3Decoder>(std::move(source_name), framing);
 }
 
 std::unique_ptr<EventEncoder> make_evt3_encoder(SensorSize sensor) {

@@ -23,7 +23,8 @@ void CameraSummary::print(std::FILE* out) const {
                "  events            %llu read, %llu published, %llu dropped (%llu off sensor, %llu back in time), %llu clock resets\n"
                "  batches           %llu (%.1f events each), %.2f MB, %.2f bytes/event, %llu publish failures\n"
                "  time              %.3f s of events in %.3f s wall (%.2fx), %.2f Mev/s, %llu loop restarts\n"
-               "  pace              furthest behind: %.1f ms, %llu jumps of event time not waited through\n",
+               "  pace              furthest behind: %.1f ms, %llu jumps of event time not waited through\n"
+               "  decoding          %llu words of reserved or unknown types skipped, %llu trigger events\n",
                source.c_str(), sensor.width, sensor.height, input_error.empty() ? "" : (" -- " + input_error).c_str(),
                static_cast<unsigned long long>(events_read), static_cast<unsigned long long>(events_published),
                static_cast<unsigned long long>(drops.total()), static_cast<unsigned long long>(drops.off_sensor),
@@ -34,7 +35,8 @@ void CameraSummary::print(std::FILE* out) const {
                events_published ? static_cast<double>(bytes) / static_cast<double>(events_published) : 0.0,
                static_cast<unsigned long long>(publish_failures), event_seconds, wall_seconds,
                wall_seconds > 0 ? event_seconds / wall_seconds : 0.0, rate * 1e-6,
-               static_cast<unsigned long long>(loops), max_lag_s * 1e3, static_cast<unsigned long long>(skipped_gaps));
+               static_cast<unsigned long long>(loops), max_lag_s * 1e3, static_cast<unsigned long long>(skipped_gaps),
+               static_cast<unsigned long long>(decoded.skipped_words), static_cast<unsigned long long>(decoded.trigger_events));
 }
 
 CameraNode::CameraNode(lcm::LCM& lcm, CameraNodeOptions options, std::int64_t epoch_us)
@@ -79,6 +81,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
     while (!stop.load()) {
       if (!source->read(chunk)) {
         if (!options_.loop) break;
+        summary.decoded += source->decode_counts();
         source = open_source();
         ++summary.loops;
         rebase = true;
@@ -110,6 +113,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
     summary.input_error = error.what();
   }
   publish_ready(true);
+  summary.decoded += source->decode_counts();
   summary.drops = validator.drops();
   summary.skipped_gaps = pacer.skipped_gaps();
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();

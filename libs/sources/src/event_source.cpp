@@ -21,6 +21,7 @@ class RecordingSource final : public EventSource {
   }
   bool read(EventBatch& batch) override { return reader_.read(batch); }
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return reader_.geometry(); }
+  [[nodiscard]] DecodeCounts decode_counts() const override { return reader_.counts(); }
   [[nodiscard]] double progress() const override {
     return static_cast<double>(reader_.bytes_read()) / static_cast<double>(std::max<std::uint64_t>(1, reader_.file_size()));
   }

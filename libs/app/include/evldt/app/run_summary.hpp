@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 
+#include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_validator.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 
@@ -14,6 +15,7 @@ struct RunSummary {
   std::string input;
   std::string input_error;  ///< set when the input ended in a format error
   std::uint64_t events_read = 0;
+  DecodeCounts decoded;  ///< words the recording's decoder skipped, trigger events it counted
   DropCounts drops;
   double event_seconds = 0;
   double wall_seconds = 0;

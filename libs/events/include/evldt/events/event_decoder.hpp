@@ -19,6 +19,21 @@
 
 namespace evldt {
 
+/// What a decoder passed over without failing: words of a type the specification reserves or does
+/// not describe, skipped as the vendor SDK skips them (some cameras pad their stream with such
+/// words), and external-trigger events, counted but not stored (lines have no use for them).
+struct DecodeCounts {
+  std::uint64_t skipped_words = 0;
+  std::uint64_t trigger_events = 0;
+
+  DecodeCounts& operator+=(const DecodeCounts& other) {
+    skipped_words += other.skipped_words;
+    trigger_events += other.trigger_events;
+    return *this;
+  }
+  friend bool operator==(const DecodeCounts&, const DecodeCounts&) = default;
+};
+
 class EventDecoder {
  public:
   virtual ~EventDecoder() = default;
@@ -34,7 +49,14 @@ class EventDecoder {
   /// Sensor size from the file header once it is parsed (EVT 2.0/3.0, dat); nullopt if the header has
   /// none or the format has no header (ECD text).
   [[nodiscard]] virtual std::optional<SensorSize> geometry() const = 0;
+
+  /// Skipped words and trigger events so far (formats without either: zero).
+  [[nodiscard]] virtual DecodeCounts counts() const { return {}; }
 };
+
+/// Whether the bytes begin with Prophesee's '%' text header (a RAW file) or are bare words (a
+/// packet of a container such as a ROS bag).
+enum class RawFraming { WithHeader, BareWords };
 
 /// `source_name` (usually the file path) prefixes every FormatError message.
 /// EVT 3.0 events before the first EVT_TIME_HIGH word have no known time and are dropped, not reported.
@@ -46,8 +68,8 @@ namespace detail {
 
 // One factory per format source file; make_decoder picks among them.
 std::unique_ptr<EventDecoder> make_ecd_text_decoder(std::string source_name);
-std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name);
-std::unique_ptr<EventDecoder> make_evt3_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name, RawFraming framing);
+std::unique_ptr<EventDecoder> make_evt3_decoder(std::string source_name, RawFraming framing);
 std::unique_ptr<EventDecoder> make_dat_decoder(std::string source_name);
 
 /// The text header that Prophesee RAW and dat files start with: lines beginning with '%'. It ends at the
@@ -67,10 +89,12 @@ class PercentHeader {
   /// Complete header lines without the line end.
   [[nodiscard]] const std::vector<std::string>& lines() const { return lines_; }
 
-  /// From "% geometry WxH", "% format NAME;height=H;width=W" or "% Width W" + "% Height H".
+  /// From "% geometry WxH", "% format NAME;height=H;width=W" or "% Width W" + "% Height H"; in a header
+  /// that names none (the 2020-era SDK), the sensor the vendor tools know from "% system_ID" or
+  /// "% plugin_name" (Gen3/3.1 640x480, Gen4/4.1/IMX636 1280x720).
   [[nodiscard]] std::optional<SensorSize> geometry() const;
   /// The data encoding the header names: "% format EVT3;..." -> "EVT3", "% evt 2.0" -> "EVT2",
-  /// "% evt 2.1" -> "EVT21"; nullopt if it names none.
+  /// "% evt 2.1" -> "EVT21"; else the default of a known "% system_ID"; nullopt if none.
   [[nodiscard]] std::optional<std::string> encoding() const;
 
  private:

@@ -35,6 +35,8 @@ class EventFileReader {
   /// Sensor size from the header (EVT 2.0/3.0, dat), nullopt if there is none.
   [[nodiscard]] std::optional<SensorSize> geometry() const { return decoder_->geometry(); }
   [[nodiscard]] EventFormat format() const { return format_; }
+  /// Words skipped and trigger events counted by the decoder so far.
+  [[nodiscard]] DecodeCounts counts() const { return decoder_->counts(); }
   /// Progress: bytes read from the file so far, and its size.
   [[nodiscard]] std::uint64_t bytes_read() const { return bytes_read_; }
   [[nodiscard]] std::uint64_t file_size() const { return file_size_; }

@@ -33,6 +33,7 @@ struct CameraSummary {
   SensorSize sensor;
   std::uint64_t events_read = 0;
   std::uint64_t events_published = 0;
+  DecodeCounts decoded;              ///< words the recording's decoder skipped, trigger events it counted
   DropCounts drops;
   std::uint64_t batches = 0;
   std::uint64_t publish_failures = 0;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "evldt/events/event.hpp"
+#include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_format.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/frame_difference.hpp"
@@ -23,6 +24,8 @@ class EventSource {
   virtual bool read(EventBatch& batch) = 0;
   /// The sensor size, where the source knows it (some recordings' headers do not say).
   [[nodiscard]] virtual std::optional<SensorSize> geometry() const = 0;
+  /// What the recording's decoder skipped or counted so far (nothing, for sources that decode nothing).
+  [[nodiscard]] virtual DecodeCounts decode_counts() const { return {}; }
   /// Fraction done, in [0, 1] (0 for a live camera).
   [[nodiscard]] virtual double progress() const = 0;
   [[nodiscard]] const std::string& name() const { return name_; }
