@@ -16,6 +16,15 @@ std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string sourc
   throw std::invalid_argument("unknown event format");
 }
 
+std::unique_ptr<EventDecoder> make_packet_decoder(std::string_view encoding, std::string source_name) {
+  if (encoding == "evt3") return detail::make_evt3_decoder(std::move(source_name), RawFraming::BareWords);
+  if (encoding == "evt2") return detail::make_evt2_decoder(std::move(source_name), RawFraming::BareWords);
+  if (encoding == "libcaer") return detail::make_libcaer_decoder(std::move(source_name));
+  if (encoding == "libcaer_cmp") return detail::make_libcaer_compressed_decoder(std::move(source_name));
+  if (encoding == "dv_events") return detail::make_dv_events_decoder(std::move(source_name));
+  return nullptr;
+}
+
 namespace {
 
 std::string lowercase(std::string text) {

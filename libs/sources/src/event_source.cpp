@@ -7,6 +7,7 @@
 #include <opencv2/videoio.hpp>
 #include <stdexcept>
 
+#include "evldt/containers/packet_source.hpp"
 #include "evldt/events/event_reader.hpp"
 #include <spdlog/spdlog.h>
 #include "evldt/transport/lcm_log.hpp"
@@ -28,6 +29,34 @@ class RecordingSource final : public EventSource {
 
  private:
   EventFileReader reader_;
+};
+
+class ContainerSource final : public EventSource {
+ public:
+  ContainerSource(std::unique_ptr<PacketSource> packets, const std::filesystem::path& path)
+      : path_(path.string()), reader_(std::move(packets), path.string()) {
+    name_ = path_ + " (" + reader_.source().description() + ")";
+  }
+  ~ContainerSource() override {
+    if (const std::uint64_t skipped = reader_.source().skipped_packets()) {
+      spdlog::info("{}: {} packets of other streams skipped", name_, skipped);
+    }
+  }
+  bool read(EventBatch& batch) override { return reader_.read(batch); }
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return geometry_; }
+  [[nodiscard]] DecodeCounts decode_counts() const override { return reader_.counts(); }
+  [[nodiscard]] double progress() const override { return reader_.source().progress(); }
+  /// Reads ahead to the first packet where the container has no size (or camera name) of its own.
+  void learn_geometry() {
+    geometry_ = reader_.geometry();
+    const std::string camera = reader_.source().camera();
+    if (!camera.empty()) name_ = path_ + " (" + reader_.source().description() + ", camera " + camera + ")";
+  }
+
+ private:
+  std::string path_;
+  PacketEventReader reader_;
+  std::optional<SensorSize> geometry_;
 };
 
 class LcmLogSource final : public EventSource {
@@ -141,8 +170,15 @@ class VideoSource final : public EventSource {
 }  // namespace
 
 std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, std::optional<EventFormat> format,
-                                            const std::string& lcm_channel, Timestamp backwards_slack_us) {
-  if (!format && is_lcm_log(path)) return std::make_unique<LcmLogSource>(path, lcm_channel, backwards_slack_us);
+                                            const std::string& channel, Timestamp backwards_slack_us) {
+  if (!format && is_lcm_log(path)) return std::make_unique<LcmLogSource>(path, channel, backwards_slack_us);
+  if (!format) {
+    if (auto packets = open_packet_container(path, channel)) {
+      auto source = std::make_unique<ContainerSource>(std::move(packets), path);
+      source->learn_geometry();
+      return source;
+    }
+  }
   return std::make_unique<RecordingSource>(path, format);
 }
 

@@ -52,6 +52,10 @@ class EventDecoder {
 
   /// Skipped words and trigger events so far (formats without either: zero).
   [[nodiscard]] virtual DecodeCounts counts() const { return {}; }
+
+  /// A container's packet begins (the bytes of the next decode() calls): its time base in ns, which
+  /// encodings that count time from the packet use (libcaer, libcaer_cmp); the others ignore it.
+  virtual void start_packet(std::int64_t /*time_base_ns*/) {}
 };
 
 /// Whether the bytes begin with Prophesee's '%' text header (a RAW file) or are bare words (a
@@ -64,6 +68,13 @@ enum class RawFraming { WithHeader, BareWords };
 /// half its range or more counts as one wrap, so output times keep increasing over long recordings.
 std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string source_name);
 
+/// The decoder of one packet encoding of a container, by the name the container gives it
+/// (event_camera_msgs' encoding field): "evt2", "evt3" (bare Prophesee words, one stream across
+/// packets), "libcaer", "libcaer_cmp" (iniVation, time from each packet's time base), "dv_events"
+/// (an AEDAT 4.0 polarity packet, handed whole); nullptr for an encoding evldt does not decode.
+/// Packet offsets in errors are relative to the packet.
+std::unique_ptr<EventDecoder> make_packet_decoder(std::string_view encoding, std::string source_name);
+
 namespace detail {
 
 // One factory per format source file; make_decoder picks among them.
@@ -71,6 +82,9 @@ std::unique_ptr<EventDecoder> make_ecd_text_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name, RawFraming framing);
 std::unique_ptr<EventDecoder> make_evt3_decoder(std::string source_name, RawFraming framing);
 std::unique_ptr<EventDecoder> make_dat_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_libcaer_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_libcaer_compressed_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_dv_events_decoder(std::string source_name);
 
 /// The text header that Prophesee RAW and dat files start with: lines beginning with '%'. It ends at the
 /// first line that does not start with '%' (the binary data), or after a "% end" line, which Prophesee

@@ -34,11 +34,12 @@ class EventSource {
   std::string name_;
 };
 
-/// A recording; an lcm-log is recognised by its content, the other formats by name or `format`.
-/// `lcm_channel` picks the event channel of an lcm-log (empty: the first EVENTS_* channel), whose
-/// batches are checked as a subscriber checks them (`backwards_slack_us` for their time order).
+/// A recording. Containers are recognised by their content: an lcm-log (its event batches, checked
+/// as a subscriber checks them, `backwards_slack_us` for their time order), a ROS 2 bag (.db3), an
+/// AEDAT 4.0 file; the other formats by name or `format`. `channel` picks the lcm-log channel or the
+/// bag topic (empty: the first EVENTS_* channel, the first event topic).
 std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, std::optional<EventFormat> format,
-                                            const std::string& lcm_channel, Timestamp backwards_slack_us);
+                                            const std::string& channel, Timestamp backwards_slack_us);
 /// A scene run through the event simulator; `label` names it in logs.
 std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label);
 

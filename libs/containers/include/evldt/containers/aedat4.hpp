@@ -1,0 +1,23 @@
+#pragma once
+// AEDAT 4.0 (iniVation's DV software: DVXplorer, DAVIS): "#!AER-DAT4.0\r\n", a size-prefixed
+// FlatBuffer header (compression, data table position, an XML description of the streams), then
+// packets: int32 stream id, int32 size, and a payload compressed whole (LZ4 frame, Zstandard frame,
+// or none) that holds a size-prefixed FlatBuffer. The first polarity stream ("EVTS") is read; other
+// streams (IMU, triggers, frames) are skipped and counted. Sensor size and camera name come from
+// the stream's sizeX, sizeY and source.
+
+#include <filesystem>
+#include <memory>
+#include <string_view>
+
+#include "evldt/containers/packet_source.hpp"
+
+namespace evldt {
+
+inline constexpr std::string_view kAedat4Magic = "#!AER-DAT4.0\r\n";
+
+/// Throws FormatError naming the file and byte offset for a header that cannot be read or a file
+/// without a polarity event stream.
+std::unique_ptr<PacketSource> open_aedat4(const std::filesystem::path& path);
+
+}  // namespace evldt

@@ -1,0 +1,245 @@
+#include "evldt/containers/aedat4.hpp"
+
+#include <flatbuffers/flatbuffers.h>
+#include <lz4frame.h>
+#include <zstd.h>
+
+#include <fstream>
+#include <map>
+#include <stdexcept>
+
+#include "aedat4_header_generated.h"
+#include "evldt/events/event_decoder.hpp"
+#include "evldt/events/event_format.hpp"
+
+namespace evldt {
+namespace {
+
+// A decompressed packet larger than this is refused: no camera writes one, and a forged size must
+// not make the reader allocate without bound.
+constexpr std::size_t kMaxPacketBytes = std::size_t{256} << 20;
+
+/// The streams the XML info node describes: for each "<node ... path=".../outInfo/ID/">" its
+/// attributes, and those of its "info/" child node (sizeX, sizeY, source).
+struct StreamInfo {
+  std::string type;
+  std::optional<SensorSize> sensor;
+  std::string source;
+};
+
+std::string_view attribute_of(std::string_view tag, std::string_view name) {
+  const std::string key = std::string(name) + "=\"";
+  const auto at = tag.find(key);
+  if (at == std::string_view::npos) return {};
+  const auto start = at + key.size();
+  const auto end = tag.find('"', start);
+  return end == std::string_view::npos ? std::string_view{} : tag.substr(start, end - start);
+}
+
+std::map<int, StreamInfo> parse_streams(std::string_view xml) {
+  std::map<std::string, std::map<std::string, std::string>> attributes_by_path;
+  std::string path;
+  for (std::size_t at = xml.find('<'); at != std::string_view::npos; at = xml.find('<', at + 1)) {
+    const auto close = xml.find('>', at);
+    if (close == std::string_view::npos) break;
+    const std::string_view tag = xml.substr(at, close - at + 1);
+    if (tag.starts_with("<node")) {
+      path = std::string(attribute_of(tag, "path"));
+    } else if (tag.starts_with("<attr")) {
+      const auto value_end = xml.find("</attr>", close);
+      if (value_end == std::string_view::npos) break;
+      attributes_by_path[path][std::string(attribute_of(tag, "key"))] = std::string(xml.substr(close + 1, value_end - close - 1));
+    }
+  }
+  std::map<int, StreamInfo> streams;
+  const std::string_view marker = "/outInfo/";
+  for (const auto& [node_path, attributes] : attributes_by_path) {
+    const auto at = node_path.find(marker);
+    if (at == std::string::npos) continue;
+    const std::string rest = node_path.substr(at + marker.size());  // "ID/" or "ID/info/"
+    const auto slash = rest.find('/');
+    if (slash == std::string::npos || slash == 0 || rest.find_first_not_of("0123456789") != slash) continue;
+    const int id = std::stoi(rest.substr(0, slash));
+    StreamInfo& stream = streams[id];
+    const auto get = [&](const char* key) {
+      const auto found = attributes.find(key);
+      return found == attributes.end() ? std::string() : found->second;
+    };
+    if (rest.size() == slash + 1) {
+      stream.type = get("typeIdentifier");
+    } else if (rest.substr(slash + 1) == "info/") {
+      stream.source = get("source");
+      try {
+        const SensorSize size{std::stoi(get("sizeX")), std::stoi(get("sizeY"))};
+        if (size.valid()) stream.sensor = size;
+      } catch (const std::exception&) {  // no or malformed size: the stream says none
+      }
+    }
+  }
+  return streams;
+}
+
+class Aedat4Source final : public PacketSource {
+ public:
+  explicit Aedat4Source(const std::filesystem::path& path) : path_(path.string()), file_(path, std::ios::binary) {
+    if (!file_) throw std::runtime_error("cannot open AEDAT 4 file '" + path_ + "'");
+    std::error_code size_error;
+    file_size_ = std::filesystem::file_size(path, size_error);
+    std::string magic(kAedat4Magic.size(), '\0');
+    read_exactly(magic.data(), magic.size(), "the version line");
+    if (magic != kAedat4Magic) throw FormatError(path_, 0, "not an AEDAT 4.0 file");
+    std::vector<std::uint8_t> header(4);
+    read_exactly(header.data(), 4, "the header size");
+    const std::uint32_t header_size = detail::load_le32(header.data());
+    if (header_size > kMaxPacketBytes) throw FormatError(path_, position_ - 4, "header size " + std::to_string(header_size));
+    header.resize(4 + header_size);
+    read_exactly(header.data() + 4, header_size, "the header");
+    flatbuffers::Verifier verifier(header.data(), header.size());
+    if (!aedat4::VerifySizePrefixedIOHeaderBuffer(verifier)) {
+      throw FormatError(path_, kAedat4Magic.size(), "the header is not a valid IOHeader FlatBuffer");
+    }
+    const aedat4::IOHeader* io = aedat4::GetSizePrefixedIOHeader(header.data());
+    compression_ = io->compression();
+    if (compression_ < aedat4::CompressionType::NONE || compression_ > aedat4::CompressionType::ZSTD_HIGH) {
+      throw FormatError(path_, kAedat4Magic.size(), "unknown compression " + std::to_string(static_cast<int>(compression_)));
+    }
+    data_end_ = io->dataTablePosition() >= 0 ? static_cast<std::uint64_t>(io->dataTablePosition()) : file_size_;
+    const auto streams = parse_streams(io->infoNode() ? io->infoNode()->string_view() : std::string_view());
+    for (const auto& [id, stream] : streams) {
+      if (stream.type == "EVTS") {
+        stream_id_ = id;
+        sensor_ = stream.sensor;
+        camera_ = stream.source;
+        break;
+      }
+    }
+    if (stream_id_ < 0) throw FormatError(path_, kAedat4Magic.size(), "no polarity event stream (EVTS) in the file");
+  }
+
+  bool next(RecordingPacket& packet) override {
+    while (position_ + 8 <= data_end_) {
+      std::uint8_t header[8];
+      const std::uint64_t at = position_;
+      read_exactly(header, 8, "a packet header");
+      const auto stream = static_cast<std::int32_t>(detail::load_le32(header));
+      const std::uint32_t size = detail::load_le32(header + 4);
+      if (size > kMaxPacketBytes || position_ + size > data_end_) {
+        throw FormatError(path_, at, "packet of " + std::to_string(size) + " bytes does not fit in the file");
+      }
+      if (stream != stream_id_) {
+        file_.seekg(static_cast<std::streamoff>(size), std::ios::cur);
+        position_ += size;
+        ++skipped_;
+        continue;
+      }
+      compressed_.resize(size);
+      read_exactly(compressed_.data(), size, "a packet");
+      packet.location = "byte " + std::to_string(at);
+      try {
+        decompress(packet.bytes);
+      } catch (const std::runtime_error& error) {
+        throw FormatError(path_, at + 8, error.what());
+      }
+      packet.encoding = "dv_events";
+      packet.time_base_ns = 0;
+      packet.sensor = sensor_;
+      return true;
+    }
+    if (position_ < data_end_ && data_end_ == file_size_) {
+      throw FormatError(path_, position_, "file ends inside a packet header (a recording cut short)");
+    }
+    return false;
+  }
+
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return sensor_; }
+  [[nodiscard]] std::string camera() const override { return camera_; }
+  [[nodiscard]] std::string description() const override {
+    return "AEDAT 4.0, stream " + std::to_string(stream_id_) + " (polarity events, " + compression_name() + ")";
+  }
+  [[nodiscard]] double progress() const override {
+    return data_end_ == 0 ? 1.0 : static_cast<double>(position_) / static_cast<double>(data_end_);
+  }
+  [[nodiscard]] std::uint64_t skipped_packets() const override { return skipped_; }
+
+ private:
+  void read_exactly(void* out, std::size_t size, const char* what) {
+    file_.read(static_cast<char*>(out), static_cast<std::streamsize>(size));
+    if (static_cast<std::size_t>(file_.gcount()) != size) {
+      throw FormatError(path_, position_ + static_cast<std::uint64_t>(file_.gcount()), std::string("file ends inside ") + what);
+    }
+    position_ += size;
+  }
+
+  [[nodiscard]] std::string compression_name() const { return aedat4::EnumNameCompressionType(compression_); }
+
+  void decompress(std::vector<std::uint8_t>& out) {
+    switch (compression_) {
+      case aedat4::CompressionType::NONE: out = compressed_; return;
+      case aedat4::CompressionType::LZ4:
+      case aedat4::CompressionType::LZ4_HIGH: decompress_lz4(out); return;
+      case aedat4::CompressionType::ZSTD:
+      case aedat4::CompressionType::ZSTD_HIGH: decompress_zstd(out); return;
+    }
+  }
+
+  // One LZ4 frame per packet; its content size is optional, so the output grows as needed.
+  void decompress_lz4(std::vector<std::uint8_t>& out) {
+    LZ4F_dctx* context = nullptr;
+    if (LZ4F_isError(LZ4F_createDecompressionContext(&context, LZ4F_VERSION))) throw std::runtime_error("LZ4: out of memory");
+    std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> owner(context, LZ4F_freeDecompressionContext);
+    out.resize(std::max<std::size_t>(compressed_.size() * 4, 1024));
+    std::size_t in_at = 0, out_at = 0;
+    while (true) {
+      std::size_t in_size = compressed_.size() - in_at, out_size = out.size() - out_at;
+      const std::size_t hint = LZ4F_decompress(context, out.data() + out_at, &out_size, compressed_.data() + in_at, &in_size, nullptr);
+      if (LZ4F_isError(hint)) throw std::runtime_error(std::string("LZ4: ") + LZ4F_getErrorName(hint));
+      in_at += in_size;
+      out_at += out_size;
+      if (hint == 0) break;  // the frame is complete
+      if (in_at == compressed_.size() && out_size == 0 && in_size == 0) throw std::runtime_error("LZ4: the frame is cut short");
+      if (out_at == out.size()) grow(out);
+    }
+    out.resize(out_at);
+  }
+
+  void decompress_zstd(std::vector<std::uint8_t>& out) {
+    std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> context(ZSTD_createDCtx(), ZSTD_freeDCtx);
+    if (!context) throw std::runtime_error("Zstandard: out of memory");
+    out.resize(std::max<std::size_t>(compressed_.size() * 4, 1024));
+    ZSTD_inBuffer in{compressed_.data(), compressed_.size(), 0};
+    std::size_t out_at = 0;
+    while (true) {
+      ZSTD_outBuffer output{out.data() + out_at, out.size() - out_at, 0};
+      const std::size_t hint = ZSTD_decompressStream(context.get(), &output, &in);
+      if (ZSTD_isError(hint)) throw std::runtime_error(std::string("Zstandard: ") + ZSTD_getErrorName(hint));
+      out_at += output.pos;
+      if (hint == 0) break;  // the frame is complete
+      if (in.pos == in.size && output.pos < output.size) throw std::runtime_error("Zstandard: the frame is cut short");
+      if (out_at == out.size()) grow(out);
+    }
+    out.resize(out_at);
+  }
+
+  static void grow(std::vector<std::uint8_t>& out) {
+    if (out.size() >= kMaxPacketBytes) throw std::runtime_error("packet decompresses to more than 256 MiB");
+    out.resize(std::min(out.size() * 2, kMaxPacketBytes));
+  }
+
+  std::string path_;
+  std::ifstream file_;
+  std::uint64_t file_size_ = 0;
+  std::uint64_t position_ = 0;
+  std::uint64_t data_end_ = 0;
+  aedat4::CompressionType compression_ = aedat4::CompressionType::NONE;
+  int stream_id_ = -1;
+  std::optional<SensorSize> sensor_;
+  std::string camera_;
+  std::uint64_t skipped_ = 0;
+  std::vector<std::uint8_t> compressed_;
+};
+
+}  // namespace
+
+std::unique_ptr<PacketSource> open_aedat4(const std::filesystem::path& path) { return std::make_unique<Aedat4Source>(path); }
+
+}  // namespace evldt

@@ -1,0 +1,81 @@
+#include "evldt/containers/packet_source.hpp"
+
+#include <array>
+#include <cstring>
+#include <fstream>
+
+#include "evldt/containers/aedat4.hpp"
+#include "evldt/containers/rosbag2.hpp"
+#include "evldt/events/event_format.hpp"
+
+namespace evldt {
+
+PacketEventReader::PacketEventReader(std::unique_ptr<PacketSource> source, std::string source_name)
+    : source_(std::move(source)), source_name_(std::move(source_name)) {}
+
+bool PacketEventReader::next_packet() {
+  if (packet_pending_) {
+    packet_pending_ = false;
+    return true;
+  }
+  if (at_end_ || !source_->next(packet_)) {
+    at_end_ = true;
+    return false;
+  }
+  if (!first_packet_sensor_) first_packet_sensor_ = packet_.sensor;
+  return true;
+}
+
+bool PacketEventReader::read(EventBatch& out) {
+  out.clear();
+  while (out.empty()) {
+    if (!next_packet()) {
+      retire_decoder(out);
+      return !out.empty();
+    }
+    if (!decoder_ || packet_.encoding != encoding_) {
+      retire_decoder(out);  // a stream that changes encoding ends the old one
+      decoder_ = make_packet_decoder(packet_.encoding, source_name_ + " " + packet_.location);
+      if (!decoder_) {
+        throw FormatError(source_name_, 0, packet_.location + ": no decoder for the event encoding '" + packet_.encoding +
+                                               "' (evldt decodes evt2, evt3, libcaer, libcaer_cmp)");
+      }
+      encoding_ = packet_.encoding;
+    }
+    decoder_->start_packet(packet_.time_base_ns);
+    decoder_->decode(packet_.bytes, out);
+  }
+  return true;
+}
+
+std::optional<SensorSize> PacketEventReader::geometry() {
+  if (const auto size = source_->geometry()) return size;
+  if (!first_packet_sensor_ && !at_end_ && !packet_pending_) packet_pending_ = next_packet();
+  return first_packet_sensor_;
+}
+
+void PacketEventReader::retire_decoder(EventBatch& out) {
+  if (!decoder_) return;
+  retired_counts_ += decoder_->counts();
+  auto decoder = std::move(decoder_);
+  decoder->finish(out);
+}
+
+DecodeCounts PacketEventReader::counts() const {
+  DecodeCounts counts = retired_counts_;
+  if (decoder_) counts += decoder_->counts();
+  return counts;
+}
+
+std::unique_ptr<PacketSource> open_packet_container(const std::filesystem::path& path, const std::string& topic) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return nullptr;
+  std::array<char, 16> magic{};
+  file.read(magic.data(), magic.size());
+  const std::string_view start(magic.data(), static_cast<std::size_t>(file.gcount()));
+  if (start.starts_with(std::string_view("SQLite format 3\0", 16))) return open_rosbag2(path, topic);
+  if (start.starts_with(kAedat4Magic)) return open_aedat4(path);
+  return nullptr;
+}
+
+}  // namespace evldt
