@@ -50,8 +50,9 @@ class ListCollector {
   int invalid_ = 0;
 };
 
+// Waits for a condition: a loaded machine or a sanitizer build is slow, not wrong, so the limit is generous.
 template <typename Condition>
-bool wait_for(Condition condition, std::chrono::milliseconds limit = 20000ms) {
+bool wait_for(Condition condition, std::chrono::milliseconds limit = 120000ms) {
   const auto deadline = std::chrono::steady_clock::now() + limit;
   while (!condition()) {
     if (std::chrono::steady_clock::now() > deadline) return false;
