@@ -13,6 +13,7 @@
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_reader.hpp"
 #include "evldt/events/event_writer.hpp"
+#include "support/temp_dir.hpp"
 
 namespace evldt {
 namespace {
@@ -24,27 +25,7 @@ constexpr Timestamp k2Pow32 = Timestamp{1} << 32;
 constexpr std::size_t kOneMiB = std::size_t{1} << 20;
 const SensorSize kSensor{1280, 720};
 
-/// A scratch directory with a unique name, removed with everything in it at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    const auto unique = std::to_string(std::random_device{}()) + "-" +
-                        std::to_string(std::chrono::steady_clock::now().time_since_epoch().count());
-    path_ = fs::temp_directory_path() / ("evldt-test-formats-" + unique);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  [[nodiscard]] fs::path file(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
+using test_support::TempDir;
 
 std::vector<Event> events_of(const EventBatch& batch) {
   std::vector<Event> events;

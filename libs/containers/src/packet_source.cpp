@@ -3,6 +3,7 @@
 #include <array>
 #include <cstring>
 #include <fstream>
+#include <utility>
 
 #include "evldt/containers/aedat4.hpp"
 #include "evldt/containers/rosbag2.hpp"
@@ -28,6 +29,20 @@ bool PacketEventReader::next_packet() {
 
 bool PacketEventReader::read(EventBatch& out) {
   out.clear();
+  if (pending_error_) std::rethrow_exception(std::exchange(pending_error_, nullptr));
+  if (failed_) return false;
+  try {
+    return fill(out);
+  } catch (const FormatError&) {
+    // The events before the fault first, then the error; after it, nothing more.
+    failed_ = true;
+    if (out.empty()) throw;
+    pending_error_ = std::current_exception();
+    return true;
+  }
+}
+
+bool PacketEventReader::fill(EventBatch& out) {
   while (out.empty()) {
     if (!next_packet()) {
       retire_decoder(out);

@@ -4,6 +4,7 @@
 // names (libs/events, make_packet_decoder) turns them into events.
 
 #include <cstdint>
+#include <exception>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -49,7 +50,8 @@ class PacketSource {
 class PacketEventReader {
  public:
   PacketEventReader(std::unique_ptr<PacketSource> source, std::string source_name);
-  /// Clears `out` and fills it with the events of the next packet(s); false at the end.
+  /// Clears `out` and fills it with the events of the next packet(s); false at the end. After a
+  /// fault it first returns the events decoded before it, throws on the next call, then returns false.
   bool read(EventBatch& out);
   /// The container's metadata, else the first packet's sensor size.
   [[nodiscard]] std::optional<SensorSize> geometry();
@@ -57,6 +59,7 @@ class PacketEventReader {
   [[nodiscard]] DecodeCounts counts() const;
 
  private:
+  bool fill(EventBatch& out);
   bool next_packet();
   /// Ends the current decoder's stream (its last events into `out`), keeping its counts.
   void retire_decoder(EventBatch& out);
@@ -66,6 +69,8 @@ class PacketEventReader {
   RecordingPacket packet_;
   bool packet_pending_ = false;  // read to learn the sensor size, not decoded yet
   bool at_end_ = false;
+  bool failed_ = false;
+  std::exception_ptr pending_error_;
   std::string encoding_;
   std::unique_ptr<EventDecoder> decoder_;
   DecodeCounts retired_counts_;
