@@ -143,12 +143,12 @@ FormatError expect_format_error(Decode&& decode) {
 // Names
 
 TEST(EventFormat, ParsesNamesAndPrintsThemBack) {
-  for (const EventFormat format : {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Dat}) {
+  for (const EventFormat format : {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat}) {
     EXPECT_EQ(parse_event_format(format_name(format)), format);
   }
   EXPECT_EQ(parse_event_format("evt3"), EventFormat::Evt3);
   EXPECT_EQ(parse_event_format("ecd"), EventFormat::EcdText);
-  EXPECT_FALSE(parse_event_format("evt21"));
+  EXPECT_FALSE(parse_event_format("evt4"));
   EXPECT_FALSE(parse_event_format(""));
 }
 
@@ -190,6 +190,7 @@ INSTANTIATE_TEST_SUITE_P(EveryFormat, RoundTrip,
                          ::testing::Values(FormatCase{EventFormat::EcdText, "events.txt"},
                                            FormatCase{EventFormat::Evt2, "events_evt2.raw"},
                                            FormatCase{EventFormat::Evt3, "events.raw"},
+                                           FormatCase{EventFormat::Evt21, "events_evt21.raw"},
                                            FormatCase{EventFormat::Dat, "events.dat"}),
                          [](const auto& test_info) { return std::string(format_name(test_info.param.format)); });
 
@@ -201,7 +202,7 @@ TEST(RoundTripEdges, EvtFormatsCrossLongGapsAndTheirOwnWraps) {
                                    {(Timestamp{1} << 34) + 100, 5, 6, -1},
                                    {(Timestamp{1} << 34) + 100, 7, 8, 1}};
   TempDir dir;
-  for (const EventFormat format : {EventFormat::Evt2, EventFormat::Evt3, EventFormat::EcdText}) {
+  for (const EventFormat format : {EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::EcdText}) {
     SCOPED_TRACE(std::string(format_name(format)));
     const fs::path path = dir.file("gaps.bin");
     write_file(path, format, written);
@@ -211,7 +212,7 @@ TEST(RoundTripEdges, EvtFormatsCrossLongGapsAndTheirOwnWraps) {
 
 TEST(RoundTripEdges, EmptyRecordingHasHeaderOnly) {
   TempDir dir;
-  for (const EventFormat format : {EventFormat::Evt2, EventFormat::Evt3, EventFormat::Dat, EventFormat::EcdText}) {
+  for (const EventFormat format : {EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat, EventFormat::EcdText}) {
     SCOPED_TRACE(std::string(format_name(format)));
     const fs::path path = dir.file("empty.bin");
     write_file(path, format, {});
@@ -269,7 +270,7 @@ TEST(Header, RawFileFormatIsTakenFromTheHeaderOrRefused) {
   EXPECT_EQ(no_version.byte_offset(), 0u);
   EXPECT_NE(std::string(no_version.what()).find(path.string()), std::string::npos);
 
-  write_bytes(path, bytes_of("% format EVT21;height=480;width=640\n% end\n"));
+  write_bytes(path, bytes_of("% format EVT4;height=480;width=640\n% end\n"));
   EXPECT_THROW(EventFileReader reader(path), FormatError);
 }
 
@@ -425,6 +426,7 @@ TEST_P(Truncated, DeliversEveryEventBeforeTheCutThenReportsItsOffset) {
       break;
     case EventFormat::Evt2: partial_start = bytes.size() - 4; bytes.resize(bytes.size() - 1); break;
     case EventFormat::Evt3: partial_start = bytes.size() - 2; bytes.resize(bytes.size() - 1); break;
+    case EventFormat::Evt21: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 3); break;
     case EventFormat::Dat: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 5); break;
   }
   write_bytes(path, bytes);
@@ -446,6 +448,7 @@ INSTANTIATE_TEST_SUITE_P(EveryFormat, Truncated,
                          ::testing::Values(FormatCase{EventFormat::EcdText, "events.txt"},
                                            FormatCase{EventFormat::Evt2, "events_evt2.raw"},
                                            FormatCase{EventFormat::Evt3, "events.raw"},
+                                           FormatCase{EventFormat::Evt21, "events_evt21.raw"},
                                            FormatCase{EventFormat::Dat, "events.dat"}),
                          [](const auto& test_info) { return std::string(format_name(test_info.param.format)); });
 
@@ -501,6 +504,35 @@ TEST(RawQuirks, Evt3PaddingAndReservedWordsAreSkippedAndCountedInAnyChunking) {
     }
     EXPECT_EQ(events_of(all), (std::vector<Event>{{0, 4, 3, 1}, {0, 5, 3, 1}}));
     EXPECT_EQ(reader.counts(), (DecodeCounts{6, 1}));
+  }
+}
+
+// EVT 2.1 from its description: a vector word sets up to 32 events; the two 32-bit halves come in
+// the order the header names, or (without one) the order of the camera's system id.
+TEST(RawQuirks, Evt21VectorsInEitherHalfOrder) {
+  const std::uint64_t time_high = std::uint64_t{0x8} << 60 | std::uint64_t{1} << 32;  // time bits 6.. = 1: 64 us
+  const std::uint64_t vector = std::uint64_t{0x1} << 60 | std::uint64_t{5} << 54 | std::uint64_t{32} << 43 |
+                               std::uint64_t{7} << 32 | 0b1011u;
+  const std::uint64_t before_time = std::uint64_t{0x0} << 60 | std::uint64_t{3} << 32 | 1u;  // no time yet: dropped
+  const std::uint64_t reserved = std::uint64_t{0x3} << 60, trigger = std::uint64_t{0xA} << 60 | std::uint64_t{1} << 32;
+  const std::vector<Event> expected{{69, 32, 7, 1}, {69, 33, 7, 1}, {69, 35, 7, 1}};
+  for (const auto& [header, legacy] : {std::pair{"% evt 2.1\n% system_ID 49\n% end\n", true},
+                                       std::pair{"% format EVT21;endianness=little;height=720;width=1280\n% end\n", false},
+                                       std::pair{"% format EVT21;endianness=legacy\n% end\n", true},
+                                       std::pair{"% format EVT21;height=320;width=320\n% end\n", false}}) {
+    SCOPED_TRACE(header);
+    auto bytes = bytes_of(header);
+    for (const std::uint64_t word : {before_time, time_high, reserved, vector, trigger}) {
+      const auto high = static_cast<std::uint32_t>(word >> 32), low = static_cast<std::uint32_t>(word);
+      append_le32(bytes, legacy ? high : low);
+      append_le32(bytes, legacy ? low : high);
+    }
+    EventBatch batch;
+    const auto decoder = make_decoder(EventFormat::Evt21, "cam.raw");
+    decoder->decode(bytes, batch);
+    decoder->finish(batch);
+    EXPECT_EQ(events_of(batch), expected);
+    EXPECT_EQ(decoder->counts(), (DecodeCounts{1, 1}));
   }
 }
 
@@ -574,7 +606,7 @@ TEST(Reader, UnknownExtensionNeedsAnExplicitFormat) {
 
 TEST(Writer, RejectsTimeGoingBackwardsAndKeepsWhatWasWritten) {
   TempDir dir;
-  for (const EventFormat format : {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Dat}) {
+  for (const EventFormat format : {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat}) {
     SCOPED_TRACE(std::string(format_name(format)));
     const fs::path path = dir.file("backwards.bin");
     EventWriter writer(path, format, kSensor);

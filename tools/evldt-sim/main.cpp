@@ -21,6 +21,7 @@ std::filesystem::path file_for(EventFormat format) {
     case EventFormat::EcdText: return "events.txt";
     case EventFormat::Evt2: return "events_evt2.raw";
     case EventFormat::Evt3: return "events.raw";
+    case EventFormat::Evt21: return "events_evt21.raw";
     case EventFormat::Dat: return "events.dat";
   }
   return "events";
@@ -87,9 +88,9 @@ int main(int argc, char** argv) {
   bool list = false;
   sim_options.add_to(app, /*scene_required=*/true);
   app.add_option("-o,--out-dir", out_dir, "Directory to write into")->capture_default_str();
-  app.add_option("--format", formats, "Recording formats to write: evt3 (events.raw), ecd (events.txt), evt2, dat")
+  app.add_option("--format", formats, "Recording formats to write: evt3 (events.raw), ecd (events.txt), evt2, evt21, dat")
       ->capture_default_str()
-      ->check(CLI::IsMember({"ecd", "evt2", "evt3", "dat"}));
+      ->check(CLI::IsMember({"ecd", "evt2", "evt3", "evt21", "dat"}));
   app.add_option("--gt-period-us", gt_period_us, "Event time between ground-truth rows")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{100}, Timestamp{10'000'000}));

@@ -12,6 +12,7 @@ std::optional<EventFormat> parse_event_format(std::string_view name) {
   if (name == "ecd") return EventFormat::EcdText;
   if (name == "evt2") return EventFormat::Evt2;
   if (name == "evt3") return EventFormat::Evt3;
+  if (name == "evt21") return EventFormat::Evt21;
   if (name == "dat") return EventFormat::Dat;
   return std::nullopt;
 }
@@ -21,6 +22,7 @@ std::string_view format_name(EventFormat format) {
     case EventFormat::EcdText: return "ecd";
     case EventFormat::Evt2: return "evt2";
     case EventFormat::Evt3: return "evt3";
+    case EventFormat::Evt21: return "evt21";
     case EventFormat::Dat: return "dat";
   }
   return "unknown";
@@ -224,9 +226,33 @@ std::optional<std::string> PercentHeader::encoding() const {
   return std::nullopt;
 }
 
+std::optional<std::string> PercentHeader::option(std::string_view key) const {
+  for (const std::string& line : lines_) {
+    const auto [line_key, value] = split_header_line(line);
+    if (equals_ignoring_case(line_key, key)) return std::string(value);
+    if (!equals_ignoring_case(line_key, "format")) continue;
+    for (std::string_view rest = value; !rest.empty();) {  // "EVT21;endianness=little;height=320"
+      const auto end = rest.find(';');
+      const std::string_view item = trim(rest.substr(0, end));
+      const auto equals = item.find('=');
+      if (equals != std::string_view::npos && equals_ignoring_case(trim(item.substr(0, equals)), key)) {
+        return std::string(trim(item.substr(equals + 1)));
+      }
+      rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 1);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<int> PercentHeader::system_id() const {
+  const auto value = option("system_ID");
+  return value ? parse_positive_int(*value) : std::nullopt;
+}
+
 std::optional<EventFormat> raw_format_from_encoding(std::string_view encoding) {
   if (equals_ignoring_case(encoding, "EVT2")) return EventFormat::Evt2;
   if (equals_ignoring_case(encoding, "EVT3")) return EventFormat::Evt3;
+  if (equals_ignoring_case(encoding, "EVT21")) return EventFormat::Evt21;
   return std::nullopt;
 }
 

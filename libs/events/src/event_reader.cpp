@@ -11,6 +11,7 @@ std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string sourc
     case EventFormat::EcdText: return detail::make_ecd_text_decoder(std::move(source_name));
     case EventFormat::Evt2: return detail::make_evt2_decoder(std::move(source_name), RawFraming::WithHeader);
     case EventFormat::Evt3: return detail::make_evt3_decoder(std::move(source_name), RawFraming::WithHeader);
+    case EventFormat::Evt21: return detail::make_evt21_decoder(std::move(source_name));
     case EventFormat::Dat: return detail::make_dat_decoder(std::move(source_name));
   }
   throw std::invalid_argument("unknown event format");
@@ -67,7 +68,7 @@ EventFileReader::EventFileReader(const std::filesystem::path& path, std::optiona
       const auto encoding = header.encoding();
       if (!encoding) throw FormatError(source_, 0, "no '% evt' or '% format' header line tells the EVT version; give the format");
       format = detail::raw_format_from_encoding(*encoding);
-      if (!format) throw FormatError(source_, 0, "the header names the encoding " + *encoding + ", not EVT2 or EVT3");
+      if (!format) throw FormatError(source_, 0, "the header names the encoding " + *encoding + ", not EVT2, EVT21 or EVT3");
     }
   }
   format_ = *format;

@@ -22,12 +22,15 @@ void check_encodable(const EventBatch& batch, Timestamp previous_time, int max_c
   }
 }
 
-void write_raw_header(int evt_version, SensorSize sensor, std::vector<std::uint8_t>& out) {
-  const std::string version = std::to_string(evt_version);
+void write_raw_header(std::string_view encoding, SensorSize sensor, std::vector<std::uint8_t>& out) {
   const std::string width = std::to_string(sensor.width);
   const std::string height = std::to_string(sensor.height);
-  const std::string header = "% evt " + version + ".0\n% format EVT" + version + ";height=" + height + ";width=" + width +
-                             "\n% geometry " + width + "x" + height + "\n% end\n";
+  // "% evt 2.0" / "% evt 3.0" for older readers; EVT 2.1 is named only by its format line, with the
+  // byte order of its 64-bit words.
+  const std::string evt_line = encoding == "EVT21" ? "" : "% evt " + std::string(encoding.substr(3)) + ".0\n";
+  const std::string options = encoding == "EVT21" ? ";endianness=little" : "";
+  const std::string header = evt_line + "% format " + std::string(encoding) + options + ";height=" + height + ";width=" +
+                             width + "\n% geometry " + width + "x" + height + "\n% end\n";
   out.insert(out.end(), header.begin(), header.end());
 }
 
@@ -38,6 +41,7 @@ std::unique_ptr<EventEncoder> make_encoder(EventFormat format, SensorSize sensor
     case EventFormat::EcdText: return detail::make_ecd_text_encoder();
     case EventFormat::Evt2: return detail::make_evt2_encoder(sensor);
     case EventFormat::Evt3: return detail::make_evt3_encoder(sensor);
+    case EventFormat::Evt21: return detail::make_evt21_encoder(sensor);
     case EventFormat::Dat: return detail::make_dat_encoder(sensor);
   }
   throw std::invalid_argument("unknown event format");

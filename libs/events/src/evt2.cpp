@@ -98,7 +98,7 @@ class Evt2Encoder final : public EventEncoder {
  public:
   explicit Evt2Encoder(SensorSize sensor) : sensor_(sensor) {}
 
-  void write_header(std::vector<std::uint8_t>& out) const override { write_raw_header(2, sensor_, out); }
+  void write_header(std::vector<std::uint8_t>& out) const override { write_raw_header("EVT2", sensor_, out); }
 
   void encode(const EventBatch& batch, std::vector<std::uint8_t>& out) override {
     check_encodable(batch, last_time_, kMaxCoordinate, "EVT 2.0");

@@ -141,7 +141,7 @@ class Evt3Encoder final : public EventEncoder {
  public:
   explicit Evt3Encoder(SensorSize sensor) : sensor_(sensor) {}
 
-  void write_header(std::vector<std::uint8_t>& out) const override { write_raw_header(3, sensor_, out); }
+  void write_header(std::vector<std::uint8_t>& out) const override { write_raw_header("EVT3", sensor_, out); }
 
   void encode(const EventBatch& batch, std::vector<std::uint8_t>& out) override {
     check_encodable(batch, last_time_, kMaxCoordinate, "EVT 3.0");

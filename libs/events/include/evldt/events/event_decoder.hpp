@@ -82,6 +82,7 @@ std::unique_ptr<EventDecoder> make_ecd_text_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name, RawFraming framing);
 std::unique_ptr<EventDecoder> make_evt3_decoder(std::string source_name, RawFraming framing);
 std::unique_ptr<EventDecoder> make_dat_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_evt21_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_compressed_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_dv_events_decoder(std::string source_name);
@@ -110,6 +111,10 @@ class PercentHeader {
   /// The data encoding the header names: "% format EVT3;..." -> "EVT3", "% evt 2.0" -> "EVT2",
   /// "% evt 2.1" -> "EVT21"; else the default of a known "% system_ID"; nullopt if none.
   [[nodiscard]] std::optional<std::string> encoding() const;
+  /// The value of "% KEY value", or of the option "KEY=value" of the "% format" line; nullopt if absent.
+  [[nodiscard]] std::optional<std::string> option(std::string_view key) const;
+  /// The "% system_ID" (decimal), if the header has one.
+  [[nodiscard]] std::optional<int> system_id() const;
 
  private:
   std::vector<std::string> lines_;
@@ -120,7 +125,7 @@ class PercentHeader {
   std::uint64_t size_ = 0;
 };
 
-/// EVT2 / EVT3 for the encodings "EVT2" / "EVT3"; nullopt for any other.
+/// EVT2 / EVT3 / EVT21 for the encodings "EVT2" / "EVT3" / "EVT21"; nullopt for any other.
 std::optional<EventFormat> raw_format_from_encoding(std::string_view encoding);
 
 inline std::uint16_t load_le16(const std::uint8_t* bytes) {

@@ -14,10 +14,11 @@ enum class EventFormat {
   EcdText,  ///< Event Camera Dataset events.txt: "t x y p" per line, t in seconds, p in {0,1}
   Evt2,     ///< Prophesee RAW EVT 2.0 (32-bit words, '%' text header)
   Evt3,     ///< Prophesee RAW EVT 3.0 (16-bit words, '%' text header)
+  Evt21,    ///< Prophesee RAW EVT 2.1 (64-bit vectorised words, '%' text header)
   Dat,      ///< Prophesee .dat CD events (8-byte records, '%' text header)
 };
 
-/// "ecd", "evt2", "evt3", "dat" -> format; nullopt for anything else.
+/// "ecd", "evt2", "evt3", "evt21", "dat" -> format; nullopt for anything else.
 std::optional<EventFormat> parse_event_format(std::string_view name);
 std::string_view format_name(EventFormat format);
 

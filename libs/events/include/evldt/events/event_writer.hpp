@@ -61,6 +61,7 @@ namespace detail {
 std::unique_ptr<EventEncoder> make_ecd_text_encoder();
 std::unique_ptr<EventEncoder> make_evt2_encoder(SensorSize sensor);
 std::unique_ptr<EventEncoder> make_evt3_encoder(SensorSize sensor);
+std::unique_ptr<EventEncoder> make_evt21_encoder(SensorSize sensor);
 std::unique_ptr<EventEncoder> make_dat_encoder(SensorSize sensor);
 
 /// Throws std::invalid_argument unless the batch's times are non-decreasing, starting from at least
@@ -75,8 +76,9 @@ inline void append_le32(std::uint32_t value, std::vector<std::uint8_t>& out) {
   for (int shift = 0; shift < 32; shift += 8) out.push_back(static_cast<std::uint8_t>(value >> shift));
 }
 
-/// The header lines of a RAW file: "% evt X.0", "% format EVTX;height=H;width=W", "% geometry WxH", "% end".
-void write_raw_header(int evt_version, SensorSize sensor, std::vector<std::uint8_t>& out);
+/// The header lines of a RAW file of `encoding` ("EVT2", "EVT3", "EVT21"): "% evt X.0" (not for
+/// EVT 2.1), "% format ENCODING;height=H;width=W", "% geometry WxH", "% end".
+void write_raw_header(std::string_view encoding, SensorSize sensor, std::vector<std::uint8_t>& out);
 
 }  // namespace detail
 }  // namespace evldt
