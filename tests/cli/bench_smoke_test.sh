@@ -12,6 +12,10 @@ for key in storage_mev_s receive_mev_s detect_hz track_hz pipeline_mev_s lattice
   value=$(grep -oP "\"$key\": \K[0-9.e+-]+" "$work/bench.json")
   awk -v v="$value" 'BEGIN { exit !(v > 0) }' || { echo "FAILED: $key = '$value'"; exit 1; }
 done
+# Decoding speed: the same events in each of the five file formats, every one read whole.
+"$1" --decode --repeats 1 >"$work/decode.txt"
+cat "$work/decode.txt"
+[[ $(grep -cP '^sample\S* +2120987 events +[0-9.]+ Mev/s' "$work/decode.txt") -eq 5 ]] || { echo "FAILED: decode table"; exit 1; }
 # A wrong flag is refused with the flag named.
 if "$1" --sizes 123x45 2>"$work/err.txt"; then echo "FAILED: bad size accepted"; exit 1; fi
 grep -q -- '--sizes' "$work/err.txt"
