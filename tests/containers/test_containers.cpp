@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 #include <lz4frame.h>
+#include <rosbag/bag.h>
 #include <sqlite3.h>
 #include <zstd.h>
 
@@ -17,10 +18,47 @@
 #include "dv_events_generated.h"
 #include "evldt/containers/aedat4.hpp"
 #include "evldt/containers/packet_source.hpp"
+#include "evldt/containers/rosbag1.hpp"
 #include "evldt/containers/rosbag2.hpp"
 #include "evldt/events/event_writer.hpp"
 #include "evldt/sources/event_source.hpp"
 #include "support/temp_dir.hpp"
+
+// A ROS 1 message given as its type name and serialized bytes, so that rosbag_storage can write
+// fixtures of message types this project has no generated code for.
+struct RawRosMessage {
+  std::string type;
+  std::vector<std::uint8_t> bytes;
+};
+
+namespace ros::message_traits {
+template <>
+struct MD5Sum<RawRosMessage> {
+  static const char* value(const RawRosMessage&) { return "*"; }
+  static const char* value() { return "*"; }
+};
+template <>
+struct DataType<RawRosMessage> {
+  static const char* value(const RawRosMessage& message) { return message.type.c_str(); }
+  static const char* value() { return "*"; }
+};
+template <>
+struct Definition<RawRosMessage> {
+  static const char* value(const RawRosMessage&) { return ""; }
+  static const char* value() { return ""; }
+};
+}  // namespace ros::message_traits
+
+namespace ros::serialization {
+template <>
+struct Serializer<RawRosMessage> {
+  template <typename Stream>
+  static void write(Stream& stream, const RawRosMessage& message) {
+    std::memcpy(stream.advance(static_cast<std::uint32_t>(message.bytes.size())), message.bytes.data(), message.bytes.size());
+  }
+  static std::uint32_t serializedLength(const RawRosMessage& message) { return static_cast<std::uint32_t>(message.bytes.size()); }
+};
+}  // namespace ros::serialization
 
 namespace evldt {
 namespace {
@@ -319,6 +357,111 @@ TEST(Rosbag2, AnUnknownEncodingOrABrokenMessageIsAnErrorAfterTheEventsBeforeIt) 
   result = read_all(path);
   EXPECT_EQ(result.events, events_of(events));
   EXPECT_NE(result.error.find("message id 2"), std::string::npos) << result.error;
+}
+
+// ---- ROS 1 bags -----------------------------------------------------------------------------------
+
+void put32(std::vector<std::uint8_t>& out, std::uint32_t value) { append_le32(out, value); }
+void put_string(std::vector<std::uint8_t>& out, const std::string& text) {
+  put32(out, static_cast<std::uint32_t>(text.size()));
+  out.insert(out.end(), text.begin(), text.end());
+}
+void put_header(std::vector<std::uint8_t>& out, const std::string& frame_id) {
+  put32(out, 7);  // seq
+  put32(out, 1700000000);
+  put32(out, 5);
+  put_string(out, frame_id);
+}
+
+/// A dvs_msgs/EventArray as ROS 1 serializes it.
+RawRosMessage dvs_event_array(const EventBatch& events, std::size_t from, std::size_t to) {
+  RawRosMessage message{kDvsEventArrayType, {}};
+  put_header(message.bytes, "dvs");
+  put32(message.bytes, 180);  // height
+  put32(message.bytes, 240);  // width
+  put32(message.bytes, static_cast<std::uint32_t>(to - from));
+  for (std::size_t i = from; i < to; ++i) {
+    append_le16(message.bytes, events.x[i]);
+    append_le16(message.bytes, events.y[i]);
+    put32(message.bytes, static_cast<std::uint32_t>(events.t[i] / 1'000'000));
+    put32(message.bytes, static_cast<std::uint32_t>(events.t[i] % 1'000'000 * 1000));
+    message.bytes.push_back(events.p[i] > 0 ? 1 : 0);
+  }
+  return message;
+}
+
+TEST(Rosbag1, DvsEventArraysInEveryChunkCompressionAndEventPackets) {
+  TempDir dir;
+  const auto path = dir.file("ecd.bag");
+  EventBatch events;
+  for (int i = 0; i < 3000; ++i) {
+    events.push_back(1'468'940'000'000'000 + 17 * i, static_cast<std::uint16_t>(i % 240), static_cast<std::uint16_t>(i % 180), i % 2 ? 1 : -1);
+  }
+  for (const auto compression : {rosbag::compression::Uncompressed, rosbag::compression::BZ2, rosbag::compression::LZ4}) {
+    SCOPED_TRACE(static_cast<int>(compression));
+    {
+      rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
+      bag.setCompression(compression);
+      bag.setChunkThreshold(4096);  // many chunks
+      for (std::size_t at = 0; at < events.size(); at += 250) {
+        const ros::Time stamp(static_cast<double>(events.t[at]) * 1e-6);
+        bag.write("/imu", stamp, RawRosMessage{"sensor_msgs/Imu", std::vector<std::uint8_t>(20, 1)});
+        bag.write("/dvs/events", stamp, dvs_event_array(events, at, std::min(events.size(), at + 250)));
+      }
+    }
+    const ReadAll result = read_all(path);
+    EXPECT_EQ(result.error, "");
+    EXPECT_EQ(result.events, events_of(events));
+    EXPECT_EQ(result.sensor, (SensorSize{240, 180}));
+    EXPECT_NE(result.name.find("ROS 1 bag, /dvs/events (dvs_msgs/EventArray), camera dvs"), std::string::npos) << result.name;
+  }
+  try {
+    read_all(path, "/imu");
+    ADD_FAILURE() << "a topic of another type";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("sensor_msgs/Imu"), std::string::npos) << error.what();
+  }
+
+  // event_camera_msgs/EventPacket with evt3, as the ROS 1 drivers record it.
+  const EventBatch sweep = sweep_events(500, 2'000'000);
+  std::vector<std::uint8_t> words;
+  detail::make_evt3_encoder({640, 480})->encode(sweep, words);
+  {
+    rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
+    RawRosMessage packet{kEventPacketType, {}};
+    put_header(packet.bytes, "prophesee");
+    put32(packet.bytes, 480);
+    put32(packet.bytes, 640);
+    for (const std::uint64_t value : {std::uint64_t{3}, std::uint64_t{0}}) {  // seq, time_base
+      for (int i = 0; i < 8; ++i) packet.bytes.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
+    }
+    put_string(packet.bytes, "evt3");
+    packet.bytes.push_back(0);  // is_bigendian
+    put_string(packet.bytes, std::string(words.begin(), words.end()));
+    bag.write("/events", ros::Time(2.0), packet);
+  }
+  const ReadAll packets = read_all(path);
+  EXPECT_EQ(packets.error, "");
+  EXPECT_EQ(packets.events, events_of(sweep));
+  EXPECT_EQ(packets.sensor, (SensorSize{640, 480}));
+}
+
+TEST(Rosbag1, ABrokenMessageIsAnErrorNamingItAfterTheEventsBeforeIt) {
+  TempDir dir;
+  const auto path = dir.file("broken.bag");
+  const EventBatch events = sweep_events(100, 1'000'000);
+  {
+    rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
+    bag.write("/dvs/events", ros::Time(1.0), dvs_event_array(events, 0, 100));
+    RawRosMessage broken = dvs_event_array(events, 0, 100);
+    broken.bytes.resize(broken.bytes.size() - 5);  // the count says 100 events, the bytes hold less
+    bag.write("/dvs/events", ros::Time(2.0), broken);
+  }
+  const ReadAll result = read_all(path);
+  std::vector<Event> expected = events_of(events);
+  EXPECT_EQ(result.events, expected);
+  EXPECT_NE(result.error.find("message 1 of /dvs/events"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("broken.bag"), std::string::npos) << result.error;
 }
 
 // ---- AEDAT 4.0 ------------------------------------------------------------------------------------

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "evldt/containers/aedat4.hpp"
+#include "evldt/containers/rosbag1.hpp"
 #include "evldt/containers/rosbag2.hpp"
 #include "evldt/events/event_format.hpp"
 
@@ -90,6 +91,7 @@ std::unique_ptr<PacketSource> open_packet_container(const std::filesystem::path&
   const std::string_view start(magic.data(), static_cast<std::size_t>(file.gcount()));
   if (start.starts_with(std::string_view("SQLite format 3\0", 16))) return open_rosbag2(path, topic);
   if (start.starts_with(kAedat4Magic)) return open_aedat4(path);
+  if (start.starts_with(kRosbag1Magic)) return open_rosbag1(path, topic);
   return nullptr;
 }
 

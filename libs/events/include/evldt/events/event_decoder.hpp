@@ -71,7 +71,8 @@ std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string sourc
 /// The decoder of one packet encoding of a container, by the name the container gives it
 /// (event_camera_msgs' encoding field): "evt2", "evt3" (bare Prophesee words, one stream across
 /// packets), "libcaer", "libcaer_cmp" (iniVation, time from each packet's time base), "dv_events"
-/// (an AEDAT 4.0 polarity packet, handed whole); nullptr for an encoding evldt does not decode.
+/// (an AEDAT 4.0 polarity packet, handed whole), "dvs_events" (a ROS 1 dvs_msgs/EventArray's
+/// records); nullptr for an encoding evldt does not decode.
 /// Packet offsets in errors are relative to the packet.
 std::unique_ptr<EventDecoder> make_packet_decoder(std::string_view encoding, std::string source_name);
 
@@ -86,6 +87,7 @@ std::unique_ptr<EventDecoder> make_evt21_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_compressed_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_dv_events_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_dvs_events_decoder(std::string source_name);
 
 /// The text header that Prophesee RAW and dat files start with: lines beginning with '%'. It ends at the
 /// first line that does not start with '%' (the binary data), or after a "% end" line, which Prophesee
