@@ -12,6 +12,8 @@
 #include <span>
 #include <string>
 
+#include "evldt/events/event_format.hpp"
+
 namespace evldt::fuzz {
 
 inline void require(bool condition, const char* what) {
@@ -19,6 +21,19 @@ inline void require(bool condition, const char* what) {
     std::fprintf(stderr, "fuzz check failed: %s\n", what);
     std::abort();
   }
+}
+
+/// Reads everything a recording reader gives, checking that it returns events whenever it says it
+/// did and that it stops for good after a FormatError.
+template <typename Reader, typename Batch>
+void read_to_the_end(Reader& reader, Batch& batch) {
+  bool failed = false;
+  try {
+    while (reader.read(batch)) require(!batch.empty(), "read() returned true with no events");
+  } catch (const FormatError&) {
+    failed = true;
+  }
+  if (failed) require(!reader.read(batch) && batch.empty(), "the reader went on after its error");
 }
 
 /// A file in the temporary directory holding the bytes under test, removed on destruction.

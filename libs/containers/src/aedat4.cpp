@@ -53,7 +53,9 @@ std::map<int, StreamInfo> parse_streams(std::string_view xml) {
   }
   std::map<int, StreamInfo> streams;
   const std::string_view marker = "/outInfo/";
-  for (const auto& [node_path, attributes] : attributes_by_path) {
+  for (const auto& entry : attributes_by_path) {
+    const std::string& node_path = entry.first;
+    const auto& attributes = entry.second;  // a plain reference: lambdas cannot capture bindings (clang 14)
     const auto at = node_path.find(marker);
     if (at == std::string::npos) continue;
     const std::string rest = node_path.substr(at + marker.size());  // "ID/" or "ID/info/"

@@ -12,6 +12,12 @@
 
 namespace evldt {
 
+std::optional<SensorSize> sensor_of(std::uint32_t width, std::uint32_t height) {
+  if (width > static_cast<std::uint32_t>(kMaxSensorSide) || height > static_cast<std::uint32_t>(kMaxSensorSide)) return std::nullopt;
+  const SensorSize sensor{static_cast<int>(width), static_cast<int>(height)};
+  return sensor.valid() ? std::optional(sensor) : std::nullopt;
+}
+
 PacketEventReader::PacketEventReader(std::unique_ptr<PacketSource> source, std::string source_name)
     : source_(std::move(source)), source_name_(std::move(source_name)) {}
 

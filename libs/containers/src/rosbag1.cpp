@@ -96,9 +96,7 @@ class Rosbag1Source final : public PacketSource {
       packet.bytes.assign(decoded.events.begin(), decoded.events.end());
       packet.encoding = decoded.encoding;
       packet.time_base_ns = static_cast<std::int64_t>(decoded.time_base);
-      const SensorSize sensor{static_cast<int>(std::min<std::uint32_t>(decoded.width, 1u << 30)),
-                              static_cast<int>(std::min<std::uint32_t>(decoded.height, 1u << 30))};
-      packet.sensor = sensor.valid() ? std::optional(sensor) : std::nullopt;
+      packet.sensor = sensor_of(decoded.width, decoded.height);
       if (camera_.empty()) camera_ = decoded.frame_id;
       ++read_;
       ++next_;

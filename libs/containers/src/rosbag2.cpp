@@ -150,9 +150,7 @@ class Rosbag2Source final : public PacketSource {
     packet.bytes.assign(message.events.begin(), message.events.end());
     packet.encoding = message.encoding;
     packet.time_base_ns = static_cast<std::int64_t>(message.time_base);
-    const SensorSize sensor{static_cast<int>(std::min<std::uint32_t>(message.width, 1u << 30)),
-                            static_cast<int>(std::min<std::uint32_t>(message.height, 1u << 30))};
-    packet.sensor = sensor.valid() ? std::optional(sensor) : std::nullopt;
+    packet.sensor = sensor_of(message.width, message.height);
     if (camera_.empty()) camera_ = message.frame_id;
     return true;
   }

@@ -6,27 +6,12 @@
 
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_writer.hpp"
+#include "evt2_time.hpp"
 
 namespace evldt::detail {
 namespace {
 
-enum Evt2Type : std::uint32_t {
-  kCdOff = 0x0,
-  kCdOn = 0x1,
-  kTimeHigh = 0x8,
-  kExtTrigger = 0xA,
-  kOthers = 0xE,
-  kContinued = 0xF,
-};
-
-constexpr int kTimeLowBits = 6;
-constexpr int kTimeHighBits = 28;
-constexpr std::uint32_t kTimeHighMask = (1u << kTimeHighBits) - 1;
-constexpr int kMaxCoordinate = 2047;  // 11 bits
-// The 28-bit time high wraps every 2^34 us (4.8 h). A time high that goes back by half its range or more
-// is a wrap; the encoder never steps forward by half the range or more, so it cannot be confused.
-constexpr std::uint32_t kTimeHighHalfRange = 1u << (kTimeHighBits - 1);
-constexpr Timestamp kMaxTimeHighStep = kTimeHighHalfRange - 1;
+using namespace evt2;
 
 class Evt2Decoder final : public EventDecoder {
  public:
@@ -66,16 +51,10 @@ class Evt2Decoder final : public EventDecoder {
     switch (word >> 28) {
       case kCdOff:
       case kCdOn:
-        out.push_back(time_high_us_ + ((word >> 22) & 0x3F), static_cast<std::uint16_t>((word >> 11) & 0x7FF),
+        out.push_back(clock_.base_us() + ((word >> 22) & 0x3F), static_cast<std::uint16_t>((word >> 11) & 0x7FF),
                       static_cast<std::uint16_t>(word & 0x7FF), (word >> 28) == kCdOn ? std::int8_t{1} : std::int8_t{-1});
         return;
-      case kTimeHigh: {
-        const std::uint32_t time_high = word & kTimeHighMask;
-        if (last_time_high_ >= time_high + kTimeHighHalfRange) wraps_ += 1;
-        last_time_high_ = time_high;
-        time_high_us_ = ((wraps_ << kTimeHighBits) + time_high) << kTimeLowBits;
-        return;
-      }
+      case kTimeHigh: clock_.on_time_high(word); return;
       case kExtTrigger: ++counts_.trigger_events; return;
       case kOthers:
       case kContinued: return;
@@ -88,10 +67,7 @@ class Evt2Decoder final : public EventDecoder {
   PercentHeader header_;
   DecodeCounts counts_;
   WordSplitter<4> words_;
-  // Before the first TIME_HIGH the time high is 0.
-  std::uint32_t last_time_high_ = 0;
-  Timestamp wraps_ = 0;
-  Timestamp time_high_us_ = 0;
+  TimeHighClock clock_;  // before the first TIME_HIGH the time high is 0
 };
 
 class Evt2Encoder final : public EventEncoder {

@@ -13,25 +13,13 @@
 
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_writer.hpp"
+#include "evt2_time.hpp"
 
 namespace evldt::detail {
 namespace {
 
-enum Evt21Type : std::uint64_t {
-  kNegative = 0x0,
-  kPositive = 0x1,
-  kTimeHigh = 0x8,
-  kExtTrigger = 0xA,
-  kOthers = 0xE,
-  kContinued = 0xF,
-};
+using namespace evt2;
 
-constexpr int kTimeLowBits = 6;
-constexpr int kTimeHighBits = 28;
-constexpr std::uint64_t kTimeHighMask = (std::uint64_t{1} << kTimeHighBits) - 1;
-constexpr std::uint64_t kTimeHighHalfRange = std::uint64_t{1} << (kTimeHighBits - 1);
-constexpr Timestamp kMaxTimeHighStep = static_cast<Timestamp>(kTimeHighHalfRange) - 1;
-constexpr int kMaxCoordinate = 2047;  // 11 bits
 constexpr int kSaphirSystemId = 0x37;
 
 class Evt21Decoder final : public EventDecoder {
@@ -80,26 +68,19 @@ class Evt21Decoder final : public EventDecoder {
 
   void decode_word(std::uint64_t word, EventBatch& out) {
     switch (word >> 60) {
-      case kNegative:
-      case kPositive: {
-        if (!has_time_) return;
-        const Timestamp t = time_high_us_ + static_cast<Timestamp>((word >> 54) & 0x3F);
+      case kCdOff:
+      case kCdOn: {
+        if (!clock_.known()) return;
+        const Timestamp t = clock_.base_us() + static_cast<Timestamp>((word >> 54) & 0x3F);
         const auto x = static_cast<std::uint32_t>((word >> 43) & 0x7FF);
         const auto y = static_cast<std::uint16_t>((word >> 32) & 0x7FF);
-        const std::int8_t polarity = (word >> 60) == kPositive ? std::int8_t{1} : std::int8_t{-1};
+        const std::int8_t polarity = (word >> 60) == kCdOn ? std::int8_t{1} : std::int8_t{-1};
         for (auto mask = static_cast<std::uint32_t>(word); mask != 0; mask &= mask - 1) {
           out.push_back(t, static_cast<std::uint16_t>(x + static_cast<std::uint32_t>(std::countr_zero(mask))), y, polarity);
         }
         return;
       }
-      case kTimeHigh: {
-        const std::uint64_t time_high = (word >> 32) & kTimeHighMask;
-        if (has_time_ && last_time_high_ >= time_high + kTimeHighHalfRange) wraps_ += 1;
-        last_time_high_ = time_high;
-        has_time_ = true;
-        time_high_us_ = ((wraps_ << kTimeHighBits) + static_cast<Timestamp>(time_high)) << kTimeLowBits;
-        return;
-      }
+      case kTimeHigh: clock_.on_time_high(static_cast<std::uint32_t>(word >> 32)); return;
       case kExtTrigger: ++counts_.trigger_events; return;
       case kOthers:
       case kContinued: return;
@@ -111,10 +92,7 @@ class Evt21Decoder final : public EventDecoder {
   PercentHeader header_;
   WordSplitter<8> words_;
   bool legacy_ = false;
-  bool has_time_ = false;
-  std::uint64_t last_time_high_ = 0;
-  Timestamp wraps_ = 0;
-  Timestamp time_high_us_ = 0;
+  TimeHighClock clock_;
   DecodeCounts counts_;
 };
 
@@ -130,9 +108,9 @@ class Evt21Encoder final : public EventEncoder {
     for (std::size_t i = 0; i < batch.size(); ++i) {
       const Timestamp t = batch.t[i];
       const Timestamp time_high = t >> kTimeLowBits;
-      while (wrote_time_high_ && time_high - time_high_ > kMaxTimeHighStep) write_time_high(time_high_ + kMaxTimeHighStep, out);
+      while (time_high - time_high_ > kMaxTimeHighStep) write_time_high(time_high_ + kMaxTimeHighStep, out);
       if (!wrote_time_high_ || time_high != time_high_) write_time_high(time_high, out);
-      const std::uint64_t type = batch.p[i] > 0 ? kPositive : kNegative;
+      const std::uint64_t type = batch.p[i] > 0 ? kCdOn : kCdOff;
       write_word(type << 60 | static_cast<std::uint64_t>(t & 0x3F) << 54 | std::uint64_t{batch.x[i]} << 43 |
                      std::uint64_t{batch.y[i]} << 32 | 1u,
                  out);

@@ -26,6 +26,9 @@ struct RecordingPacket {
   std::string location;             ///< where the packet is, for errors: "byte 1234", "message 17"
 };
 
+/// A message's width and height as a sensor size, if they make one (a valid size, kMaxSensorSide at most).
+std::optional<SensorSize> sensor_of(std::uint32_t width, std::uint32_t height);
+
 class PacketSource {
  public:
   virtual ~PacketSource() = default;
