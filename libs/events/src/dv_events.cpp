@@ -5,6 +5,9 @@
 
 #include <flatbuffers/flatbuffers.h>
 
+#include <cstring>
+#include <vector>
+
 #include "dv_events_generated.h"
 #include "evldt/events/event_decoder.hpp"
 
@@ -16,6 +19,12 @@ class DvEventsDecoder final : public EventDecoder {
   explicit DvEventsDecoder(std::string source) : source_(std::move(source)) {}
 
   void decode(std::span<const std::uint8_t> packet, EventBatch& out) override {
+    if (reinterpret_cast<std::uintptr_t>(packet.data()) % alignof(std::uint64_t) != 0) {
+      // FlatBuffers reads its fields in place: a packet handed at an odd address is copied first.
+      aligned_.resize((packet.size() + sizeof(std::uint64_t) - 1) / sizeof(std::uint64_t));
+      std::memcpy(aligned_.data(), packet.data(), packet.size());
+      packet = {reinterpret_cast<const std::uint8_t*>(aligned_.data()), packet.size()};
+    }
     flatbuffers::Verifier verifier(packet.data(), packet.size());
     if (!dv::VerifySizePrefixedEventPacketBuffer(verifier)) {
       throw FormatError(source_, 0, "not a valid size-prefixed FlatBuffer event packet (identifier EVTS)");
@@ -38,6 +47,7 @@ class DvEventsDecoder final : public EventDecoder {
  private:
   std::string source_;
   DecodeCounts counts_;
+  std::vector<std::uint64_t> aligned_;
 };
 
 }  // namespace
