@@ -77,7 +77,7 @@ class DatDecoder final : public EventDecoder {
   }
 
   std::string source_;
-  PercentHeader header_;
+  TextHeader header_;
   int type_and_size_read_ = 0;
   WordSplitter<kRecordBytes> records_;
   std::uint32_t last_time_ = 0;

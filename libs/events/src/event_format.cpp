@@ -93,11 +93,11 @@ std::optional<SensorSize> parse_format_value(std::string_view value) {
 
 }  // namespace
 
-std::size_t PercentHeader::consume(std::span<const std::uint8_t> bytes, const std::string& source) {
+std::size_t TextHeader::consume(std::span<const std::uint8_t> bytes, const std::string& source) {
   std::size_t used = 0;
   while (used < bytes.size() && !complete_) {
     if (!in_line_) {
-      if (bytes[used] != '%') {
+      if (bytes[used] != marker_) {
         complete_ = true;
         break;
       }
@@ -116,7 +116,7 @@ std::size_t PercentHeader::consume(std::span<const std::uint8_t> bytes, const st
     ++used;  // the '\n'
     if (!line_.empty() && line_.back() == '\r') line_.pop_back();
     in_line_ = false;
-    complete_ = trim(line_) == "% end";
+    complete_ = is_end_line(line_);
     lines_.push_back(std::move(line_));
     line_.clear();
   }
@@ -124,7 +124,12 @@ std::size_t PercentHeader::consume(std::span<const std::uint8_t> bytes, const st
   return used;
 }
 
-void PercentHeader::finish(const std::string& source) const {
+bool TextHeader::is_end_line(std::string_view line) const {
+  line = trim(line);
+  return line == "% end" || line == "#!END-HEADER" || equals_ignoring_case(line, "#End Of ASCII Header");
+}
+
+void TextHeader::finish(const std::string& source) const {
   if (in_line_) throw FormatError(source, line_start_, "file ends inside a header line");
 }
 
@@ -184,7 +189,7 @@ std::optional<SensorSize> known_plugin_sensor(const std::vector<std::string>& li
 
 }  // namespace
 
-std::optional<SensorSize> PercentHeader::geometry() const {
+std::optional<SensorSize> TextHeader::geometry() const {
   std::optional<SensorSize> from_geometry;
   std::optional<SensorSize> from_format;
   std::optional<int> width;
@@ -208,7 +213,7 @@ std::optional<SensorSize> PercentHeader::geometry() const {
   return known_plugin_sensor(lines_);
 }
 
-std::optional<std::string> PercentHeader::encoding() const {
+std::optional<std::string> TextHeader::encoding() const {
   std::optional<std::string> from_evt_line;
   for (const std::string& line : lines_) {
     const auto [key, value] = split_header_line(line);
@@ -226,7 +231,7 @@ std::optional<std::string> PercentHeader::encoding() const {
   return std::nullopt;
 }
 
-std::optional<std::string> PercentHeader::option(std::string_view key) const {
+std::optional<std::string> TextHeader::option(std::string_view key) const {
   for (const std::string& line : lines_) {
     const auto [line_key, value] = split_header_line(line);
     if (equals_ignoring_case(line_key, key)) return std::string(value);
@@ -244,7 +249,7 @@ std::optional<std::string> PercentHeader::option(std::string_view key) const {
   return std::nullopt;
 }
 
-std::optional<int> PercentHeader::system_id() const {
+std::optional<int> TextHeader::system_id() const {
   const auto value = option("system_ID");
   return value ? parse_positive_int(*value) : std::nullopt;
 }

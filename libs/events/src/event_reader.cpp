@@ -58,7 +58,7 @@ EventFileReader::EventFileReader(const std::filesystem::path& path, std::optiona
   // Read the '%' header now so that format() and geometry() are known before the first read().
   std::vector<std::uint8_t> header_bytes;
   if (format != EventFormat::EcdText) {
-    detail::PercentHeader header;
+    detail::TextHeader header;
     while (!header.complete()) {
       const std::size_t size = read_chunk();
       if (size == 0) break;

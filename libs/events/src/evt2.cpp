@@ -64,7 +64,7 @@ class Evt2Decoder final : public EventDecoder {
 
   std::string source_;
   bool bare_words_;
-  PercentHeader header_;
+  TextHeader header_;
   DecodeCounts counts_;
   WordSplitter<4> words_;
   TimeHighClock clock_;  // before the first TIME_HIGH the time high is 0

@@ -89,7 +89,7 @@ class Evt21Decoder final : public EventDecoder {
   }
 
   std::string source_;
-  PercentHeader header_;
+  TextHeader header_;
   WordSplitter<8> words_;
   bool legacy_ = false;
   TimeHighClock clock_;

@@ -123,7 +123,7 @@ class Evt3Decoder final : public EventDecoder {
 
   std::string source_;
   bool bare_words_;
-  PercentHeader header_;
+  TextHeader header_;
   DecodeCounts counts_;
   WordSplitter<2> words_;
   std::uint16_t y_ = 0;

@@ -89,11 +89,13 @@ std::unique_ptr<EventDecoder> make_libcaer_compressed_decoder(std::string source
 std::unique_ptr<EventDecoder> make_dv_events_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_dvs_events_decoder(std::string source_name);
 
-/// The text header that Prophesee RAW and dat files start with: lines beginning with '%'. It ends at the
-/// first line that does not start with '%' (the binary data), or after a "% end" line, which Prophesee
-/// writes last so that data starting with the byte '%' is not taken for header.
-class PercentHeader {
+/// The text header that recordings start with: lines beginning with a marker, '%' (Prophesee RAW and
+/// dat) or '#' (AEDAT 2.0 / 3.1). It ends at the first line that does not start with the marker (the
+/// binary data), or after the line its writers put last so that data starting with the marker byte
+/// is not taken for header: "% end", "#!END-HEADER" (cAER), "#End Of ASCII Header" (jAER).
+class TextHeader {
  public:
+  explicit TextHeader(char marker = '%') : marker_(marker) {}
   /// Consumes header bytes from the front of `bytes` and returns how many; the rest is data.
   /// Throws FormatError for a header line too long to be one (binary data starting with '%').
   std::size_t consume(std::span<const std::uint8_t> bytes, const std::string& source);
@@ -119,6 +121,9 @@ class PercentHeader {
   [[nodiscard]] std::optional<int> system_id() const;
 
  private:
+  [[nodiscard]] bool is_end_line(std::string_view line) const;
+
+  char marker_;
   std::vector<std::string> lines_;
   std::string line_;           // the header line being read
   std::uint64_t line_start_ = 0;
