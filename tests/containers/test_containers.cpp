@@ -272,7 +272,7 @@ TEST(Rosbag2, LibcaerPacketsCountFromTheirTimeBaseAcrossTheTimeWrap) {
   {
     BagWriter bag(path);
     bag.topic(1, "/events", kEventPacketType);
-    PacketFields first{.frame_id = "davis", .width = 346, .height = 260, .encoding = "libcaer"};
+    PacketFields first{.frame_id = "davis", .width = 346, .height = 260, .encoding = "libcaer", .events = {}};
     first.time_base = 7'000'000'000'123ULL;  // ns; not a whole us
     record(first.events, 1, 2, true, 10);
     record(first.events, 3, 4, false, 2147483640);
@@ -303,17 +303,17 @@ TEST(Rosbag2, LibcaerCompressedColumnsVectorsAndPerPacketTime) {
   {
     BagWriter bag(path);
     bag.topic(1, "/events", kEventPacketType);
-    PacketFields packet{.frame_id = "davis", .width = 346, .height = 260, .encoding = "libcaer_cmp"};
+    PacketFields packet{.frame_id = "davis", .width = 346, .height = 260, .encoding = "libcaer_cmp", .events = {}};
     packet.time_base = 2'000'000;  // 2000 us
     // t = 0x001 << 12 | 0x005 us: x 17, one event (y 3, ON), then a vector at base y 8 (OFF): 8 and 10;
     // an unknown code 0x9, skipped; then x 18 and one event at y 260 - 1.
-    for (const std::uint16_t word : {0x0001, 0x1005, 0x2011, 0x3803, 0x4008, 0x5005, 0x9ABC, 0x2012, 0x3103}) {
+    for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x0001, 0x1005, 0x2011, 0x3803, 0x4008, 0x5005, 0x9ABC, 0x2012, 0x3103}) {
       append_le16(packet.events, word);
     }
     bag.message(1, 1, event_packet_cdr(packet));
     packet.events.clear();
     packet.time_base = 3'000'000;  // the time starts again at the next packet's base; x carries over
-    for (const std::uint16_t word : {0x1002, 0x3804}) append_le16(packet.events, word);
+    for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x1002, 0x3804}) append_le16(packet.events, word);
     bag.message(1, 2, event_packet_cdr(packet));
   }
   const ReadAll result = read_all(path);

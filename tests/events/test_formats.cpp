@@ -428,6 +428,8 @@ TEST_P(Truncated, DeliversEveryEventBeforeTheCutThenReportsItsOffset) {
     case EventFormat::Evt3: partial_start = bytes.size() - 2; bytes.resize(bytes.size() - 1); break;
     case EventFormat::Evt21: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 3); break;
     case EventFormat::Dat: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 5); break;
+    case EventFormat::Aedat2:
+    case EventFormat::Aedat31: FAIL() << "evldt does not write " << format_name(format);
   }
   write_bytes(path, bytes);
   const std::vector<Event> before_cut(written.begin(), written.end() - 1);
@@ -491,7 +493,7 @@ TEST(RawQuirks, Evt3PaddingAndReservedWordsAreSkippedAndCountedInAnyChunking) {
   auto bytes = bytes_of("% evt 3.0\n% end\n");
   // TIME_HIGH 0, y 3, x 4, then IMX636-style 0x9999 padding and the other reserved types, a
   // trigger, and x 5.
-  for (const std::uint16_t word : {0x8000, 0x0003, 0x2804, 0x9999, 0x9999, 0x1000, 0xB000, 0xC000, 0xD000, 0xA001, 0x2805}) {
+  for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x8000, 0x0003, 0x2804, 0x9999, 0x9999, 0x1000, 0xB000, 0xC000, 0xD000, 0xA001, 0x2805}) {
     append_le16(bytes, word);
   }
   write_bytes(path, bytes);
@@ -536,10 +538,101 @@ TEST(RawQuirks, Evt21VectorsInEitherHalfOrder) {
   }
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// AEDAT 2.0 and 3.1, from iniVation's and jAER's format descriptions
+
+void append_be32(std::vector<std::uint8_t>& bytes, std::uint32_t value) {
+  for (int shift = 24; shift >= 0; shift -= 8) bytes.push_back(static_cast<std::uint8_t>(value >> shift));
+}
+
+/// A 28-byte AEDAT 3.1 packet header: type, source 1, event size, timestamp offset 4, overflow,
+/// capacity = number = valid = count.
+void append_aedat3_packet_header(std::vector<std::uint8_t>& bytes, std::uint16_t type, std::uint32_t event_size,
+                                 std::uint32_t overflow, std::uint32_t count) {
+  append_le16(bytes, type);
+  append_le16(bytes, 1);
+  for (const std::uint32_t value : {event_size, 4u, overflow, count, count, count}) append_le32(bytes, value);
+}
+
+void append_polarity(std::vector<std::uint8_t>& bytes, std::uint32_t x, std::uint32_t y, bool on, std::uint32_t t, bool valid = true) {
+  append_le32(bytes, x << 17 | y << 2 | (on ? 2u : 0u) | (valid ? 1u : 0u));
+  append_le32(bytes, t);
+}
+
+TEST(Aedat, Aedat31PolarityPacketsWithTheirOverflowOtherPacketsSkipped) {
+  TempDir dir;
+  const fs::path path = dir.file("davis.aedat");
+  auto bytes = bytes_of("#!AER-DAT3.1\r\n#Format: RAW\r\n#Source 1: DAVIS346B\r\n#Start-Time: 2017-06-07 10:00:00 (TZ+0200)\r\n"
+                        "#!END-HEADER\r\n");
+  append_aedat3_packet_header(bytes, 1, 8, 0, 3);
+  append_polarity(bytes, 5, 7, true, 100);
+  append_polarity(bytes, 6, 7, true, 150, /*valid=*/false);
+  append_polarity(bytes, 345, 259, false, 200);
+  append_aedat3_packet_header(bytes, 2, 10, 0, 2);  // a frame packet: 20 bytes, skipped
+  bytes.insert(bytes.end(), 20, 0x23);
+  const std::size_t third_packet = bytes.size();
+  append_aedat3_packet_header(bytes, 1, 8, 1, 1);  // time overflowed once
+  append_polarity(bytes, 1, 2, true, 5);
+  write_bytes(path, bytes);
+  const std::vector<Event> expected{{100, 5, 7, 1}, {200, 345, 259, -1}, {(Timestamp{1} << 31) + 5, 1, 2, 1}};
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, kOneMiB}) {
+    SCOPED_TRACE(chunk);
+    const ReadResult result = read_file(path, std::nullopt, chunk);  // recognised by its first line
+    EXPECT_FALSE(result.error);
+    EXPECT_EQ(result.events, expected);
+    EventFileReader reader(path, std::nullopt, chunk);
+    EXPECT_EQ(reader.format(), EventFormat::Aedat31);
+    EXPECT_EQ(reader.geometry(), (SensorSize{346, 260}));
+    EventBatch batch;
+    while (reader.read(batch)) {
+    }
+    EXPECT_EQ(reader.counts().skipped_words, 2u);  // the invalid event and the frame packet
+  }
+  bytes.resize(third_packet + 30);  // cut inside the last packet
+  write_bytes(path, bytes);
+  const ReadResult cut = read_file(path, std::nullopt, 7);
+  EXPECT_EQ(cut.events, std::vector<Event>(expected.begin(), expected.begin() + 2));
+  ASSERT_TRUE(cut.error);
+  EXPECT_EQ(cut.error->byte_offset(), third_packet);
+}
+
+TEST(Aedat, Aedat2AddressesOfDavisAndDvs128ChipsMirroredToATopLeftOrigin) {
+  TempDir dir;
+  const fs::path path = dir.file("rec.aedat");
+  auto davis = bytes_of("#!AER-DAT2.0\r\n# This is a raw AE data file\r\n# AEChip: eu.seebetter.ini.chips.davis.DAVIS240C\r\n"
+                        "#End Of ASCII Header\r\n");
+  auto record = [](std::vector<std::uint8_t>& bytes, std::uint32_t address, std::uint32_t t) {
+    append_be32(bytes, address);
+    append_be32(bytes, t);
+  };
+  record(davis, 20u << 22 | 10u << 12 | 1u << 11, 0xFFFFFFF0u);  // ON at raw (10, 20)
+  record(davis, 0x80000000u | 5u << 12, 0xFFFFFFF1u);            // an APS sample: skipped
+  record(davis, 1u << 10, 0xFFFFFFF2u);                          // an external input: a trigger
+  record(davis, 0u << 22 | 239u << 12, 0x10u);                   // OFF at raw (239, 0), after the 2^32 us wrap
+  write_bytes(path, davis);
+  EventFileReader reader(path, std::nullopt, 5);
+  EXPECT_EQ(reader.format(), EventFormat::Aedat2);
+  EXPECT_EQ(reader.geometry(), (SensorSize{240, 180}));
+  EXPECT_EQ(read_file(path, std::nullopt, 5).events,
+            (std::vector<Event>{{0xFFFFFFF0, 229, 159, 1}, {(Timestamp{1} << 32) + 0x10, 0, 179, -1}}));
+  EventBatch batch;
+  while (reader.read(batch)) {
+  }
+  EXPECT_EQ(reader.counts(), (DecodeCounts{1, 1}));
+
+  auto dvs128 = bytes_of("#!AER-DAT2.0\r\n# created 2008\r\n");  // no chip line: a DVS128
+  record(dvs128, 4u << 8 | 3u << 1 | 0u, 7);  // raw (3, 4), polarity bit 0: ON
+  record(dvs128, 0x8000u, 8);                 // an external event
+  record(dvs128, 127u << 8 | 0u << 1 | 1u, 9);
+  write_bytes(path, dvs128);
+  EXPECT_EQ(EventFileReader(path).geometry(), (SensorSize{128, 128}));
+  EXPECT_EQ(read_file(path, std::nullopt, kOneMiB).events, (std::vector<Event>{{7, 124, 123, 1}, {9, 127, 0, -1}}));
+}
+
 TEST(RawQuirks, BareWordsHaveNoHeaderEvenWhenTheyStartWithAPercentByte) {
   // 0x0025 is EVT_ADDR_Y 37, whose first byte is '%'.
   std::vector<std::uint8_t> bytes;
-  for (const std::uint16_t word : {0x8000, 0x0025, 0x2804}) append_le16(bytes, word);
+  for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x8000, 0x0025, 0x2804}) append_le16(bytes, word);
   bytes.insert(bytes.begin(), {0x25, 0x00});  // y = 37 first
   EventBatch batch;
   const auto decoder = detail::make_evt3_decoder("packet", RawFraming::BareWords);

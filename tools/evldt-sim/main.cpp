@@ -23,6 +23,8 @@ std::filesystem::path file_for(EventFormat format) {
     case EventFormat::Evt3: return "events.raw";
     case EventFormat::Evt21: return "events_evt21.raw";
     case EventFormat::Dat: return "events.dat";
+    case EventFormat::Aedat2:
+    case EventFormat::Aedat31: break;  // not written
   }
   return "events";
 }

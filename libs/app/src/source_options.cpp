@@ -8,7 +8,7 @@ namespace evldt {
 
 void SourceOptions::add_to(CLI::App& app) {
   app.add_option("input", recording_,
-                 "Recording: Prophesee RAW (EVT 2.0/2.1/3.0) or .dat, ECD events.txt, a ROS 2 bag (.db3), AEDAT 4.0, or an\n"
+                 "Recording: Prophesee RAW (EVT 2.0/2.1/3.0) or .dat, ECD events.txt, a ROS 1 or 2 bag, AEDAT 2.0/3.1/4.0, or an\n"
                  "lcm-log of event batches; the format and sensor size come from the file")
       ->check(CLI::ExistingFile);
   app.add_option("--format", format_, "Recording format when the name does not tell: ecd, evt2, evt3, evt21, dat")

@@ -14,6 +14,8 @@ std::optional<EventFormat> parse_event_format(std::string_view name) {
   if (name == "evt3") return EventFormat::Evt3;
   if (name == "evt21") return EventFormat::Evt21;
   if (name == "dat") return EventFormat::Dat;
+  if (name == "aedat2") return EventFormat::Aedat2;
+  if (name == "aedat31") return EventFormat::Aedat31;
   return std::nullopt;
 }
 
@@ -24,6 +26,8 @@ std::string_view format_name(EventFormat format) {
     case EventFormat::Evt3: return "evt3";
     case EventFormat::Evt21: return "evt21";
     case EventFormat::Dat: return "dat";
+    case EventFormat::Aedat2: return "aedat2";
+    case EventFormat::Aedat31: return "aedat31";
   }
   return "unknown";
 }

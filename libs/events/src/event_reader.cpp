@@ -13,6 +13,8 @@ std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string sourc
     case EventFormat::Evt3: return detail::make_evt3_decoder(std::move(source_name), RawFraming::WithHeader);
     case EventFormat::Evt21: return detail::make_evt21_decoder(std::move(source_name));
     case EventFormat::Dat: return detail::make_dat_decoder(std::move(source_name));
+    case EventFormat::Aedat2: return detail::make_aedat2_decoder(std::move(source_name));
+    case EventFormat::Aedat31: return detail::make_aedat31_decoder(std::move(source_name));
   }
   throw std::invalid_argument("unknown event format");
 }
@@ -43,6 +45,15 @@ EventFileReader::EventFileReader(const std::filesystem::path& path, std::optiona
   file_size_ = std::filesystem::file_size(path, size_error);
   if (size_error) file_size_ = 0;
 
+  // AEDAT files say what they are in their first line, whatever their name.
+  if (!format) {
+    std::string start(12, '\0');
+    file_.read(start.data(), static_cast<std::streamsize>(start.size()));
+    if (start.starts_with("#!AER-DAT2")) format = EventFormat::Aedat2;
+    if (start.starts_with("#!AER-DAT3")) format = EventFormat::Aedat31;
+    file_.clear();
+    file_.seekg(0);
+  }
   const std::string extension = lowercase(path.extension().string());
   const bool format_from_header = !format && extension == ".raw";
   if (!format && !format_from_header) {
@@ -51,14 +62,14 @@ EventFileReader::EventFileReader(const std::filesystem::path& path, std::optiona
     } else if (extension == ".dat") {
       format = EventFormat::Dat;
     } else {
-      throw std::runtime_error("cannot tell the format of '" + source_ + "' from its name: give it (ecd, evt2, evt3, dat)");
+      throw std::runtime_error("cannot tell the format of '" + source_ + "' from its name: give it (ecd, evt2, evt3, evt21, dat)");
     }
   }
 
-  // Read the '%' header now so that format() and geometry() are known before the first read().
+  // Read the text header now so that format() and geometry() are known before the first read().
   std::vector<std::uint8_t> header_bytes;
   if (format != EventFormat::EcdText) {
-    detail::TextHeader header;
+    detail::TextHeader header(format == EventFormat::Aedat2 || format == EventFormat::Aedat31 ? '#' : '%');
     while (!header.complete()) {
       const std::size_t size = read_chunk();
       if (size == 0) break;

@@ -84,6 +84,8 @@ std::unique_ptr<EventDecoder> make_evt2_decoder(std::string source_name, RawFram
 std::unique_ptr<EventDecoder> make_evt3_decoder(std::string source_name, RawFraming framing);
 std::unique_ptr<EventDecoder> make_dat_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_evt21_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_aedat2_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_aedat31_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_compressed_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_dv_events_decoder(std::string source_name);
