@@ -429,7 +429,8 @@ TEST_P(Truncated, DeliversEveryEventBeforeTheCutThenReportsItsOffset) {
     case EventFormat::Evt21: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 3); break;
     case EventFormat::Dat: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 5); break;
     case EventFormat::Aedat2:
-    case EventFormat::Aedat31: FAIL() << "evldt does not write " << format_name(format);
+    case EventFormat::Aedat31:
+    case EventFormat::EventStream: FAIL() << "evldt does not write " << format_name(format);
   }
   write_bytes(path, bytes);
   const std::vector<Event> before_cut(written.begin(), written.end() - 1);
@@ -627,6 +628,52 @@ TEST(Aedat, Aedat2AddressesOfDavisAndDvs128ChipsMirroredToATopLeftOrigin) {
   write_bytes(path, dvs128);
   EXPECT_EQ(EventFileReader(path).geometry(), (SensorSize{128, 128}));
   EXPECT_EQ(read_file(path, std::nullopt, kOneMiB).events, (std::vector<Event>{{7, 124, 123, 1}, {9, 127, 0, -1}}));
+}
+
+// Event Stream 2.x, from its description: time deltas in a byte, overflow bytes, x and y; the origin
+// is the bottom left.
+TEST(EventStream, DvsAndAtisEventsWithTheirTimeDeltas) {
+  TempDir dir;
+  const fs::path path = dir.file("rec.es");
+  auto header = [](std::uint8_t type) {
+    auto bytes = bytes_of("Event Stream");
+    bytes.insert(bytes.end(), {2, 0, 0, type});
+    append_le16(bytes, 304);
+    append_le16(bytes, 240);
+    return bytes;
+  };
+  auto coordinates = [](std::vector<std::uint8_t>& bytes, std::uint16_t x, std::uint16_t y) {
+    append_le16(bytes, x);
+    append_le16(bytes, y);
+  };
+  auto dvs = header(1);
+  dvs.push_back(0xFF);            // t += 127
+  dvs.push_back(10 << 1 | 1);     // t += 10: ON
+  coordinates(dvs, 3, 0);         // bottom row
+  dvs.push_back(0xFE);            // reset: nothing
+  dvs.push_back(0 << 1 | 0);      // same time, OFF
+  coordinates(dvs, 303, 239);
+  write_bytes(path, dvs);
+  EXPECT_EQ(EventFileReader(path, std::nullopt, 3).format(), EventFormat::EventStream);
+  EXPECT_EQ(EventFileReader(path, std::nullopt, 3).geometry(), (SensorSize{304, 240}));
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{5}, kOneMiB}) {
+    EXPECT_EQ(read_file(path, std::nullopt, chunk).events, (std::vector<Event>{{137, 3, 239, 1}, {137, 303, 0, -1}}));
+  }
+
+  auto atis = header(2);
+  atis.push_back(0xFE);            // t += 63 * 2
+  atis.push_back(5 << 2 | 2);      // t += 5: a change detection, ON
+  coordinates(atis, 7, 8);
+  atis.push_back(1 << 2 | 1);      // t += 1: a threshold crossing, skipped
+  coordinates(atis, 7, 8);
+  write_bytes(path, atis);
+  EXPECT_EQ(read_file(path, std::nullopt, 2).events, (std::vector<Event>{{131, 7, 231, 1}}));
+
+  atis.resize(atis.size() - 2);  // cut inside the last event
+  write_bytes(path, atis);
+  const ReadResult cut = read_file(path, std::nullopt, 4);
+  ASSERT_TRUE(cut.error);
+  EXPECT_EQ(cut.error->byte_offset(), atis.size() - 3);
 }
 
 TEST(RawQuirks, BareWordsHaveNoHeaderEvenWhenTheyStartWithAPercentByte) {

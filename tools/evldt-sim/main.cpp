@@ -24,7 +24,8 @@ std::filesystem::path file_for(EventFormat format) {
     case EventFormat::Evt21: return "events_evt21.raw";
     case EventFormat::Dat: return "events.dat";
     case EventFormat::Aedat2:
-    case EventFormat::Aedat31: break;  // not written
+    case EventFormat::Aedat31:
+    case EventFormat::EventStream: break;  // not written
   }
   return "events";
 }

@@ -15,6 +15,7 @@ std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string sourc
     case EventFormat::Dat: return detail::make_dat_decoder(std::move(source_name));
     case EventFormat::Aedat2: return detail::make_aedat2_decoder(std::move(source_name));
     case EventFormat::Aedat31: return detail::make_aedat31_decoder(std::move(source_name));
+    case EventFormat::EventStream: return detail::make_event_stream_decoder(std::move(source_name));
   }
   throw std::invalid_argument("unknown event format");
 }
@@ -45,12 +46,13 @@ EventFileReader::EventFileReader(const std::filesystem::path& path, std::optiona
   file_size_ = std::filesystem::file_size(path, size_error);
   if (size_error) file_size_ = 0;
 
-  // AEDAT files say what they are in their first line, whatever their name.
+  // AEDAT and Event Stream files say what they are in their first bytes, whatever their name.
   if (!format) {
     std::string start(12, '\0');
     file_.read(start.data(), static_cast<std::streamsize>(start.size()));
     if (start.starts_with("#!AER-DAT2")) format = EventFormat::Aedat2;
     if (start.starts_with("#!AER-DAT3")) format = EventFormat::Aedat31;
+    if (start.starts_with("Event Stream")) format = EventFormat::EventStream;
     file_.clear();
     file_.seekg(0);
   }
@@ -68,7 +70,7 @@ EventFileReader::EventFileReader(const std::filesystem::path& path, std::optiona
 
   // Read the text header now so that format() and geometry() are known before the first read().
   std::vector<std::uint8_t> header_bytes;
-  if (format != EventFormat::EcdText) {
+  if (format != EventFormat::EcdText && format != EventFormat::EventStream) {
     detail::TextHeader header(format == EventFormat::Aedat2 || format == EventFormat::Aedat31 ? '#' : '%');
     while (!header.complete()) {
       const std::size_t size = read_chunk();
@@ -81,6 +83,13 @@ EventFileReader::EventFileReader(const std::filesystem::path& path, std::optiona
       if (!encoding) throw FormatError(source_, 0, "no '% evt' or '% format' header line tells the EVT version; give the format");
       format = detail::raw_format_from_encoding(*encoding);
       if (!format) throw FormatError(source_, 0, "the header names the encoding " + *encoding + ", not EVT2, EVT21 or EVT3");
+    }
+  } else if (format == EventFormat::EventStream) {
+    constexpr std::size_t kEventStreamHeaderBytes = 20;  // its sensor size ends there
+    while (header_bytes.size() < kEventStreamHeaderBytes) {
+      const std::size_t size = read_chunk();
+      if (size == 0) break;
+      header_bytes.insert(header_bytes.end(), chunk_.begin(), chunk_.begin() + static_cast<std::ptrdiff_t>(size));
     }
   }
   format_ = *format;

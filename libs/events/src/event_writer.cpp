@@ -44,7 +44,8 @@ std::unique_ptr<EventEncoder> make_encoder(EventFormat format, SensorSize sensor
     case EventFormat::Evt21: return detail::make_evt21_encoder(sensor);
     case EventFormat::Dat: return detail::make_dat_encoder(sensor);
     case EventFormat::Aedat2:
-    case EventFormat::Aedat31: throw std::invalid_argument("evldt reads " + std::string(format_name(format)) + " but does not write it");
+    case EventFormat::Aedat31:
+    case EventFormat::EventStream: throw std::invalid_argument("evldt reads " + std::string(format_name(format)) + " but does not write it");
   }
   throw std::invalid_argument("unknown event format");
 }

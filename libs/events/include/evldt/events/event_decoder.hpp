@@ -86,6 +86,7 @@ std::unique_ptr<EventDecoder> make_dat_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_evt21_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_aedat2_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_aedat31_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_event_stream_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_compressed_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_dv_events_decoder(std::string source_name);

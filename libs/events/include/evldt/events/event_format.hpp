@@ -18,9 +18,10 @@ enum class EventFormat {
   Dat,      ///< Prophesee .dat CD events (8-byte records, '%' text header)
   Aedat2,   ///< jAER AEDAT 2.0 (big-endian 8-byte address/time records, '#' text header); read only
   Aedat31,  ///< cAER AEDAT 3.1 (packets of typed events, '#' text header); read only
+  EventStream,  ///< Event Stream .es 2.x, DVS and ATIS (time deltas in bytes); read only
 };
 
-/// "ecd", "evt2", "evt3", "evt21", "dat", "aedat2", "aedat31" -> format; nullopt for anything else.
+/// "ecd", "evt2", "evt3", "evt21", "dat", "aedat2", "aedat31", "es" -> format; nullopt for anything else.
 std::optional<EventFormat> parse_event_format(std::string_view name);
 std::string_view format_name(EventFormat format);
 
