@@ -153,7 +153,7 @@ plot for [i=0:$((${#names[@]} - 1))] "$out/soak.csv" using 1:(column(2 + 3 * i))
 set ylabel "CPU %"
 plot for [i=0:$((${#names[@]} - 1))] "$out/soak.csv" using 1:(column(3 + 3 * i)) skip 1 with lines title word("${names[*]}", i + 1)
 set ylabel "latency ms / lost"
-n = 2 + 3 * ${#names[@]}
+n = 1 + 3 * ${#names[@]}  # the columns before batches_received
 plot "$out/soak.csv" using 1:(column(n + 3)) skip 1 with lines title "median latency", \
      "" using 1:(column(n + 4)) skip 1 with lines title "p99 latency", \
      "" using 1:(column(n + 2)) skip 1 with lines title "batches lost"
