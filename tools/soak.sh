@@ -106,6 +106,8 @@ trap - EXIT
 cat "$out/evldt-camera.out" "$out/evldt-lines.out" "$out/evldt-viz.out"
 viz_lost=$(grep -oP 'batches \(\K[0-9]+(?= lost)' "$out/evldt-viz.out" || echo "?")
 [[ $viz_lost == 0 ]] || failure+="${failure:+; }evldt-viz lost $viz_lost batches"
+lines_lost=$(grep -oP 'received, \K[0-9]+(?= lost)' "$out/evldt-lines.out" || echo "?")
+[[ $lines_lost == 0 ]] || failure+="${failure:+; }evldt-lines lost $lines_lost batches"
 
 # Growth of each process's RSS: the peak over the last window against the peak over the first
 # window after the first minute (a window is 5 min, or a third of the rest of a shorter run). Peaks,
