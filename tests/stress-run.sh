@@ -25,7 +25,7 @@ done
 echo "stress run: $rounds round(s) of ${suites[*]} with $jobs busy-loop processes hogging the cores"
 
 logs=$(mktemp -d)
-declare -A failed_runs
+declare -A failed_runs=()
 runs=0
 started=$SECONDS
 for round in $(seq "$rounds"); do
