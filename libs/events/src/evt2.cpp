@@ -80,11 +80,7 @@ class Evt2Encoder final : public EventEncoder {
     check_encodable(batch, last_time_, kMaxCoordinate, "EVT 2.0");
     for (std::size_t i = 0; i < batch.size(); ++i) {
       const Timestamp t = batch.t[i];
-      const Timestamp time_high = t >> kTimeLowBits;
-      // Long gaps go in steps the decoder can follow across the 2^34 us wrap.
-      while (time_high - time_high_ > kMaxTimeHighStep) write_time_high(time_high_ + kMaxTimeHighStep, out);
-      // Always one TIME_HIGH before the first event: other decoders may wait for it.
-      if (time_high != time_high_ || !wrote_time_high_) write_time_high(time_high, out);
+      time_high_.before_event(t, [&](std::uint32_t time_high) { append_le32(std::uint32_t{kTimeHigh} << 28 | time_high, out); });
       const std::uint32_t type = batch.p[i] > 0 ? kCdOn : kCdOff;
       append_le32((type << 28) | (static_cast<std::uint32_t>(t & 0x3F) << 22) |
                       (static_cast<std::uint32_t>(batch.x[i]) << 11) | batch.y[i],
@@ -94,16 +90,9 @@ class Evt2Encoder final : public EventEncoder {
   }
 
  private:
-  void write_time_high(Timestamp time_high, std::vector<std::uint8_t>& out) {
-    time_high_ = time_high;
-    wrote_time_high_ = true;
-    append_le32((std::uint32_t{kTimeHigh} << 28) | (static_cast<std::uint32_t>(time_high) & kTimeHighMask), out);
-  }
-
   SensorSize sensor_;
   Timestamp last_time_ = 0;
-  Timestamp time_high_ = 0;  // as the decoder sees it before the first TIME_HIGH
-  bool wrote_time_high_ = false;
+  TimeHighWriter time_high_;
 };
 
 }  // namespace

@@ -107,9 +107,9 @@ class Evt21Encoder final : public EventEncoder {
     check_encodable(batch, last_time_, kMaxCoordinate, "EVT 2.1");
     for (std::size_t i = 0; i < batch.size(); ++i) {
       const Timestamp t = batch.t[i];
-      const Timestamp time_high = t >> kTimeLowBits;
-      while (time_high - time_high_ > kMaxTimeHighStep) write_time_high(time_high_ + kMaxTimeHighStep, out);
-      if (!wrote_time_high_ || time_high != time_high_) write_time_high(time_high, out);
+      time_high_.before_event(t, [&](std::uint32_t time_high) {
+        write_word(std::uint64_t{kTimeHigh} << 60 | std::uint64_t{time_high} << 32, out);
+      });
       const std::uint64_t type = batch.p[i] > 0 ? kCdOn : kCdOff;
       write_word(type << 60 | static_cast<std::uint64_t>(t & 0x3F) << 54 | std::uint64_t{batch.x[i]} << 43 |
                      std::uint64_t{batch.y[i]} << 32 | 1u,
@@ -119,11 +119,6 @@ class Evt21Encoder final : public EventEncoder {
   }
 
  private:
-  void write_time_high(Timestamp time_high, std::vector<std::uint8_t>& out) {
-    time_high_ = time_high;
-    wrote_time_high_ = true;
-    write_word(std::uint64_t{kTimeHigh} << 60 | (static_cast<std::uint64_t>(time_high) & kTimeHighMask) << 32, out);
-  }
   static void write_word(std::uint64_t word, std::vector<std::uint8_t>& out) {
     append_le32(static_cast<std::uint32_t>(word), out);
     append_le32(static_cast<std::uint32_t>(word >> 32), out);
@@ -131,8 +126,7 @@ class Evt21Encoder final : public EventEncoder {
 
   SensorSize sensor_;
   Timestamp last_time_ = 0;
-  Timestamp time_high_ = 0;
-  bool wrote_time_high_ = false;
+  TimeHighWriter time_high_;
 };
 
 }  // namespace

@@ -48,4 +48,28 @@ class TimeHighClock {
   Timestamp base_us_ = 0;
 };
 
+/// The encoders' side: the TIME_HIGH words to write before an event so that a TimeHighClock follows.
+class TimeHighWriter {
+ public:
+  /// Calls write(time_high) for each TIME_HIGH due before an event at `t`: long gaps in steps the
+  /// wrap detection can follow, and always one before the first event (other decoders wait for it).
+  template <typename Write>
+  void before_event(Timestamp t, Write&& write) {
+    const Timestamp time_high = t >> kTimeLowBits;
+    while (time_high - time_high_ > kMaxTimeHighStep) emit(time_high_ + kMaxTimeHighStep, write);
+    if (!wrote_ || time_high != time_high_) emit(time_high, write);
+  }
+
+ private:
+  template <typename Write>
+  void emit(Timestamp time_high, Write& write) {
+    time_high_ = time_high;
+    wrote_ = true;
+    write(static_cast<std::uint32_t>(time_high) & kTimeHighMask);
+  }
+
+  Timestamp time_high_ = 0;  // as the decoder sees it before the first TIME_HIGH
+  bool wrote_ = false;
+};
+
 }  // namespace evldt::detail::evt2
