@@ -80,9 +80,7 @@ class Aedat31Decoder final : public EventDecoder {
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
     if (!header_.complete()) {
-      const std::size_t used = header_.consume(chunk, source_);
-      chunk = chunk.subspan(used);
-      if (!header_.complete()) return;
+      if (!header_.take(chunk, source_)) return;
       read_header();
       offset_ = header_.size();
     }
@@ -190,9 +188,7 @@ class Aedat2Decoder final : public EventDecoder {
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
     if (!header_.complete()) {
-      const std::size_t used = header_.consume(chunk, source_);
-      chunk = chunk.subspan(used);
-      if (!header_.complete()) return;
+      if (!header_.take(chunk, source_)) return;
       read_header();
       records_.set_offset(header_.size());
     }

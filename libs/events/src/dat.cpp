@@ -26,9 +26,7 @@ class DatDecoder final : public EventDecoder {
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
     if (!header_.complete()) {
-      const std::size_t used = header_.consume(chunk, source_);
-      chunk = chunk.subspan(used);
-      if (!header_.complete()) return;
+      if (!header_.take(chunk, source_)) return;
     }
     while (type_and_size_read_ < 2 && !chunk.empty()) {
       read_type_or_size(chunk.front());

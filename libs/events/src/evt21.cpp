@@ -28,9 +28,7 @@ class Evt21Decoder final : public EventDecoder {
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
     if (!header_.complete()) {
-      const std::size_t used = header_.consume(chunk, source_);
-      chunk = chunk.subspan(used);
-      if (!header_.complete()) return;
+      if (!header_.take(chunk, source_)) return;
       read_header();
       words_.set_offset(header_.size());
     }

@@ -52,9 +52,7 @@ class Evt3Decoder final : public EventDecoder {
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
     if (!bare_words_ && !header_.complete()) {
-      const std::size_t used = header_.consume(chunk, source_);
-      chunk = chunk.subspan(used);
-      if (!header_.complete()) return;
+      if (!header_.take(chunk, source_)) return;
       check_encoding();
       words_.set_offset(header_.size());
     }

@@ -102,6 +102,12 @@ class TextHeader {
   /// Consumes header bytes from the front of `bytes` and returns how many; the rest is data.
   /// Throws FormatError for a header line too long to be one (binary data starting with '%').
   std::size_t consume(std::span<const std::uint8_t> bytes, const std::string& source);
+  /// The same for a decoder: consumes header bytes from the front of `chunk`, leaving it the data;
+  /// true once the header is complete.
+  bool take(std::span<const std::uint8_t>& chunk, const std::string& source) {
+    chunk = chunk.subspan(consume(chunk, source));
+    return complete_;
+  }
   /// End of input: a header line without its '\n' means a truncated file.
   void finish(const std::string& source) const;
 
