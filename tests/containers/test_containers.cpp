@@ -1,11 +1,13 @@
 // Recording containers and the packet encodings, on fixtures written here from the format
-// descriptions (ROS 2 bags in SQLite with event_camera_msgs/EventPacket in CDR; AEDAT 4.0 with
-// LZ4 / Zstandard packets), and on the real recordings in ../shared/real when they are there.
+// descriptions (ROS 2 bags in SQLite and MCAP files with event_camera_msgs/EventPacket and
+// dvs_msgs/EventArray in CDR; ROS 1 bags written with rosbag_storage; AEDAT 4.0 with LZ4 /
+// Zstandard packets), and on the real recordings in ../shared/real when they are there.
 
 #include <gtest/gtest.h>
 #include <lz4frame.h>
 #include <rosbag/bag.h>
 #include <sqlite3.h>
+#include <zlib.h>
 #include <zstd.h>
 
 #include <bit>
@@ -17,8 +19,10 @@
 #include "aedat4_header_generated.h"
 #include "dv_events_generated.h"
 #include "evldt/containers/aedat4.hpp"
+#include "evldt/containers/mcap.hpp"
 #include "evldt/containers/packet_source.hpp"
 #include "evldt/containers/rosbag1.hpp"
+#include "evldt/containers/ros_messages.hpp"
 #include "evldt/containers/rosbag2.hpp"
 #include "evldt/events/event_writer.hpp"
 #include "evldt/sources/event_source.hpp"
@@ -211,16 +215,18 @@ TEST(Cdr, EventPacketDecodesInEitherByteOrderAndRefusesTruncation) {
   for (const bool little : {true, false}) {
     SCOPED_TRACE(little);
     const auto bytes = event_packet_cdr(fields, little);
-    const EventPacketMessage message = decode_event_packet_cdr(bytes);
+    std::vector<std::uint8_t> scratch;
+    const RosEventMessage message = decode_ros_event_message(RosSerialization::Cdr, kRos2EventPacketType, bytes, scratch);
     EXPECT_EQ(message.frame_id, "cam-7");
     EXPECT_EQ(message.width, 640u);
     EXPECT_EQ(message.height, 480u);
-    EXPECT_EQ(message.seq, 42u);
     EXPECT_EQ(message.time_base, 1234567890123ULL);
     EXPECT_EQ(message.encoding, "libcaer");
     EXPECT_EQ(std::vector<std::uint8_t>(message.events.begin(), message.events.end()), fields.events);
     for (std::size_t cut = 0; cut < bytes.size(); cut += 3) {
-      EXPECT_THROW(decode_event_packet_cdr(std::span(bytes).first(cut)), std::runtime_error) << cut;
+      EXPECT_THROW(decode_ros_event_message(RosSerialization::Cdr, kRos2EventPacketType, std::span(bytes).first(cut), scratch),
+                   std::runtime_error)
+          << cut;
     }
   }
 }
@@ -234,7 +240,7 @@ TEST(Rosbag2, Evt3PacketsAreOneStreamSplitAnywhere) {
   {
     BagWriter bag(path);
     bag.topic(1, "/imu", "sensor_msgs/msg/Imu");
-    bag.topic(2, "/event_camera/events", kEventPacketType);
+    bag.topic(2, "/event_camera/events", std::string(kRos2EventPacketType));
     bag.message(1, 10, {0, 1, 0, 0, 9, 9});
     // Packets cut at odd word counts: state (y, base x, time) carries from one packet to the next.
     PacketFields fields;
@@ -271,7 +277,7 @@ TEST(Rosbag2, LibcaerPacketsCountFromTheirTimeBaseAcrossTheTimeWrap) {
   };
   {
     BagWriter bag(path);
-    bag.topic(1, "/events", kEventPacketType);
+    bag.topic(1, "/events", std::string(kRos2EventPacketType));
     PacketFields first{.frame_id = "davis", .width = 346, .height = 260, .encoding = "libcaer", .events = {}};
     first.time_base = 7'000'000'000'123ULL;  // ns; not a whole us
     record(first.events, 1, 2, true, 10);
@@ -302,7 +308,7 @@ TEST(Rosbag2, LibcaerCompressedColumnsVectorsAndPerPacketTime) {
   const auto path = dir.file("cmp.db3");
   {
     BagWriter bag(path);
-    bag.topic(1, "/events", kEventPacketType);
+    bag.topic(1, "/events", std::string(kRos2EventPacketType));
     PacketFields packet{.frame_id = "davis", .width = 346, .height = 260, .encoding = "libcaer_cmp", .events = {}};
     packet.time_base = 2'000'000;  // 2000 us
     // t = 0x001 << 12 | 0x005 us: x 17, one event (y 3, ON), then a vector at base y 8 (OFF): 8 and 10;
@@ -331,22 +337,22 @@ TEST(Rosbag2, AnUnknownEncodingOrABrokenMessageIsAnErrorAfterTheEventsBeforeIt) 
   detail::make_evt3_encoder({640, 480})->encode(events, words);
   {
     BagWriter bag(path);
-    bag.topic(1, "/events", kEventPacketType);
+    bag.topic(1, "/events", std::string(kRos2EventPacketType));
     PacketFields good;
     good.events = words;
     bag.message(1, 1, event_packet_cdr(good));
     PacketFields odd = good;
-    odd.encoding = "mono";
+    odd.encoding = "evt4";
     bag.message(1, 2, event_packet_cdr(odd));
   }
   ReadAll result = read_all(path);
   EXPECT_EQ(result.events, events_of(events));
-  EXPECT_NE(result.error.find("no decoder for the event encoding 'mono'"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("no decoder for the event encoding 'evt4'"), std::string::npos) << result.error;
   EXPECT_NE(result.error.find("odd.db3"), std::string::npos) << result.error;
 
   {
     BagWriter bag(path);
-    bag.topic(1, "/events", kEventPacketType);
+    bag.topic(1, "/events", std::string(kRos2EventPacketType));
     PacketFields good;
     good.events = words;
     bag.message(1, 1, event_packet_cdr(good));
@@ -357,6 +363,77 @@ TEST(Rosbag2, AnUnknownEncodingOrABrokenMessageIsAnErrorAfterTheEventsBeforeIt) 
   result = read_all(path);
   EXPECT_EQ(result.events, events_of(events));
   EXPECT_NE(result.error.find("message id 2"), std::string::npos) << result.error;
+}
+
+/// The "mono" encoding's 64-bit word: [31:0] ns after the time base, [47:32] x, [62:48] y, [63] polarity.
+void append_mono(std::vector<std::uint8_t>& out, std::uint32_t dt_ns, std::uint16_t x, std::uint16_t y, bool on) {
+  append_le32(out, dt_ns);
+  append_le32(out, x | static_cast<std::uint32_t>(y) << 16 | (on ? 0x80000000u : 0u));
+}
+
+TEST(Rosbag2, MonoPacketsCountNanosecondsFromTheirTimeBase) {
+  TempDir dir;
+  const auto path = dir.file("mono.db3");
+  {
+    BagWriter bag(path);
+    bag.topic(1, "/events", std::string(kRos2EventPacketType));
+    PacketFields packet{.frame_id = "imx636", .width = 1280, .height = 720, .encoding = "mono", .events = {}};
+    packet.time_base = 5'000'000'000'500ULL;  // ns
+    append_mono(packet.events, 0, 1279, 719, true);
+    append_mono(packet.events, 499, 0, 0, false);       // 5'000'000'000'999 ns: still the same us
+    append_mono(packet.events, 4'000'000'000u, 17, 33, true);  // 4 s on: the full 32 bits
+    bag.message(1, 1, event_packet_cdr(packet));
+    packet.events.resize(12);  // a word cut short
+    bag.message(1, 2, event_packet_cdr(packet));
+  }
+  const ReadAll result = read_all(path);
+  const Timestamp base = 5'000'000'000;
+  EXPECT_EQ(result.events, (std::vector<Event>{{base, 1279, 719, 1}, {base, 0, 0, -1}, {base + 4'000'000, 17, 33, 1}, {base, 1279, 719, 1}}));
+  EXPECT_NE(result.error.find("inside an 8-byte event"), std::string::npos) << result.error;
+  EXPECT_EQ(result.sensor, (SensorSize{1280, 720}));
+}
+
+/// A dvs_msgs/msg/EventArray in CDR: each event's fields aligned to their size, so events are padded
+/// differently depending on where they start.
+std::vector<std::uint8_t> event_array_cdr(const EventBatch& events, bool little_endian) {
+  CdrWriter cdr(little_endian);
+  cdr.put<std::int32_t>(1700000000);
+  cdr.put<std::uint32_t>(9);
+  cdr.put_string("dvxplorer");
+  cdr.put<std::uint32_t>(480);  // height
+  cdr.put<std::uint32_t>(640);  // width
+  cdr.put(static_cast<std::uint32_t>(events.size()));
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    cdr.put(events.x[i]);
+    cdr.put(events.y[i]);
+    cdr.put(static_cast<std::int32_t>(events.t[i] / 1'000'000));
+    cdr.put(static_cast<std::uint32_t>(events.t[i] % 1'000'000 * 1000));
+    cdr.put<std::uint8_t>(events.p[i] > 0 ? 1 : 0);
+  }
+  return cdr.bytes();
+}
+
+TEST(Rosbag2, DvsEventArraysInCdrOfEitherByteOrder) {
+  TempDir dir;
+  const auto path = dir.file("dvs.db3");
+  const EventBatch events = sweep_events(700, 1'700'000'000'000'000);
+  {
+    BagWriter bag(path);
+    bag.topic(1, "/dvs/events", std::string(kRos2EventArrayType));
+    EventBatch part;
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      part.push_back(events.t[i], events.x[i], events.y[i], events.p[i]);
+      if (part.size() == 233 || i + 1 == events.size()) {
+        bag.message(1, static_cast<std::int64_t>(i), event_array_cdr(part, i % 2 == 0));
+        part.clear();
+      }
+    }
+  }
+  const ReadAll result = read_all(path);
+  EXPECT_EQ(result.error, "");
+  EXPECT_EQ(result.events, events_of(events));
+  EXPECT_EQ(result.sensor, (SensorSize{640, 480}));
+  EXPECT_NE(result.name.find("/dvs/events (dvs_msgs/msg/EventArray), camera dvxplorer"), std::string::npos) << result.name;
 }
 
 // ---- ROS 1 bags -----------------------------------------------------------------------------------
@@ -375,7 +452,7 @@ void put_header(std::vector<std::uint8_t>& out, const std::string& frame_id) {
 
 /// A dvs_msgs/EventArray as ROS 1 serializes it.
 RawRosMessage dvs_event_array(const EventBatch& events, std::size_t from, std::size_t to) {
-  RawRosMessage message{kDvsEventArrayType, {}};
+  RawRosMessage message{std::string(kRos1EventArrayType), {}};
   put_header(message.bytes, "dvs");
   put32(message.bytes, 180);  // height
   put32(message.bytes, 240);  // width
@@ -428,7 +505,7 @@ TEST(Rosbag1, DvsEventArraysInEveryChunkCompressionAndEventPackets) {
   detail::make_evt3_encoder({640, 480})->encode(sweep, words);
   {
     rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
-    RawRosMessage packet{kEventPacketType, {}};
+    RawRosMessage packet{std::string(kRos1EventPacketType), {}};
     put_header(packet.bytes, "prophesee");
     put32(packet.bytes, 480);
     put32(packet.bytes, 640);
@@ -567,6 +644,179 @@ TEST(Aedat4, ACutFileGivesEveryWholePacketThenAnErrorAtItsOffset) {
 
   // A header that is no FlatBuffer is refused at once, naming the file.
   std::ofstream(path, std::ios::binary) << kAedat4Magic << std::string("\x10\0\0\0", 4) << std::string(16, 'x');
+  EXPECT_THROW(read_all(path), FormatError);
+}
+
+// ---- MCAP -----------------------------------------------------------------------------------------
+
+/// An MCAP file as rosbag2's MCAP storage writes one: schemas and channels, then messages, in chunks
+/// (or, with no `compression`, at the top level), then DataEnd, an empty summary and the footer.
+class McapWriter {
+ public:
+  explicit McapWriter(std::optional<std::string> compression) : compression_(std::move(compression)) {
+    file_.assign(kMcapMagic.begin(), kMcapMagic.end());
+    record(file_, 0x01, string_field("ros2") + string_field("evldt test"));
+  }
+  void schema(std::uint16_t id, const std::string& name, const std::string& encoding = "ros2msg") {
+    record(target(), 0x03, le(id, 2) + string_field(name) + string_field(encoding) + string_field("# definition"));
+  }
+  void channel(std::uint16_t id, std::uint16_t schema, const std::string& topic, const std::string& encoding = "cdr") {
+    record(target(), 0x04, le(id, 2) + le(schema, 2) + string_field(topic) + string_field(encoding) + le(0, 4));
+  }
+  void message(std::uint16_t channel, std::uint64_t time, const std::vector<std::uint8_t>& data) {
+    record(target(), 0x05, le(channel, 2) + le(sequence_++, 4) + le(time, 8) + le(time, 8) + std::string(data.begin(), data.end()));
+  }
+  /// Ends the chunk being written; returns where it starts in the file.
+  std::uint64_t end_chunk(bool corrupt_crc = false) {
+    const std::uint64_t at = file_.size();
+    if (!compression_ || chunk_.empty()) return at;
+    std::vector<std::uint8_t> records(chunk_.begin(), chunk_.end());
+    std::vector<std::uint8_t> stored = records;
+    if (*compression_ == "lz4") stored = compress(aedat4::CompressionType::LZ4, records);
+    if (*compression_ == "zstd") stored = compress(aedat4::CompressionType::ZSTD, records);
+    const auto crc = static_cast<std::uint32_t>(crc32(0, records.data(), static_cast<uInt>(records.size()))) ^ (corrupt_crc ? 1u : 0u);
+    record(file_, 0x06, le(0, 8) + le(0, 8) + le(records.size(), 8) + le(crc, 4) + string_field(*compression_) + le(stored.size(), 8) +
+                            std::string(stored.begin(), stored.end()));
+    chunk_.clear();
+    return at;
+  }
+  /// DataEnd, the footer and the closing magic; `path` written.
+  void finish(const std::filesystem::path& path, bool close = true) {
+    end_chunk();
+    if (close) {
+      record(file_, 0x0F, le(0, 4));
+      record(file_, 0x02, le(0, 8) + le(0, 8) + le(0, 4));
+      file_.insert(file_.end(), kMcapMagic.begin(), kMcapMagic.end());
+    }
+    std::ofstream(path, std::ios::binary).write(file_.data(), static_cast<std::streamsize>(file_.size()));
+  }
+
+ private:
+  static std::string le(std::uint64_t value, int bytes) {
+    std::string out;
+    for (int i = 0; i < bytes; ++i) out.push_back(static_cast<char>(value >> (8 * i)));
+    return out;
+  }
+  static std::string string_field(const std::string& text) { return le(text.size(), 4) + text; }
+  static void record(std::string& out, std::uint8_t opcode, const std::string& content) {
+    out.push_back(static_cast<char>(opcode));
+    out += le(content.size(), 8) + content;
+  }
+  std::string& target() { return compression_ ? chunk_ : file_; }
+
+  std::optional<std::string> compression_;
+  std::string file_, chunk_;
+  std::uint32_t sequence_ = 0;
+};
+
+TEST(Mcap, EventPacketsInChunksOfEveryCompressionOrNone) {
+  TempDir dir;
+  const auto path = dir.file("rec.mcap");
+  const EventBatch events = sweep_events(4000, 9'000'000);
+  std::vector<std::uint8_t> words;
+  detail::make_evt3_encoder({640, 480})->encode(events, words);
+  for (const std::optional<std::string> compression : {std::optional<std::string>(), std::optional<std::string>(""),
+                                                       std::optional<std::string>("lz4"), std::optional<std::string>("zstd")}) {
+    SCOPED_TRACE(compression.value_or("no chunks"));
+    McapWriter mcap(compression);
+    mcap.schema(1, "sensor_msgs/msg/Imu");
+    mcap.channel(1, 1, "/imu");
+    mcap.schema(2, std::string(kRos2EventPacketType));
+    mcap.channel(2, 2, "/event_camera/events");
+    PacketFields fields;
+    for (std::size_t at = 0, seq = 0; at < words.size(); ++seq) {
+      const std::size_t size = std::min<std::size_t>(words.size() - at, 2 * (41 + 97 * (seq % 4)));
+      fields.events.assign(words.begin() + static_cast<std::ptrdiff_t>(at), words.begin() + static_cast<std::ptrdiff_t>(at + size));
+      mcap.message(1, seq, std::vector<std::uint8_t>(24, 3));
+      mcap.message(2, seq, event_packet_cdr(fields));
+      at += size;
+      if (seq % 7 == 6) mcap.end_chunk();
+    }
+    mcap.finish(path);
+    const ReadAll result = read_all(path);
+    EXPECT_EQ(result.error, "");
+    EXPECT_EQ(result.events, events_of(events));
+    EXPECT_EQ(result.sensor, (SensorSize{640, 480}));
+    EXPECT_NE(result.name.find("MCAP, /event_camera/events (event_camera_msgs/msg/EventPacket), camera cam-7"), std::string::npos)
+        << result.name;
+  }
+  try {
+    read_all(path, "/imu");
+    ADD_FAILURE() << "a channel of another type";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("/imu is of type sensor_msgs/msg/Imu"), std::string::npos) << error.what();
+  }
+  try {
+    read_all(path, "/nothing");
+    ADD_FAILURE() << "no such channel";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("channels: /imu (sensor_msgs/msg/Imu, cdr), /event_camera/events"), std::string::npos)
+        << error.what();
+  }
+}
+
+TEST(Mcap, Ros1EventArraysAndTopicChoice) {
+  TempDir dir;
+  const auto path = dir.file("ecd.mcap");
+  EventBatch first, second;
+  for (int i = 0; i < 300; ++i) {
+    first.push_back(1'000'000 + i, static_cast<std::uint16_t>(i % 240), 5, 1);
+    second.push_back(2'000'000 + i, 7, static_cast<std::uint16_t>(i % 180), -1);
+  }
+  McapWriter mcap("zstd");
+  mcap.schema(1, std::string(kRos1EventArrayType), "ros1msg");
+  mcap.channel(1, 1, "/dvs/events", "ros1");
+  mcap.channel(2, 1, "/dvs_right/events", "ros1");
+  mcap.message(1, 1, dvs_event_array(first, 0, first.size()).bytes);
+  mcap.message(2, 1, dvs_event_array(second, 0, second.size()).bytes);
+  mcap.finish(path);
+  const ReadAll left = read_all(path);
+  EXPECT_EQ(left.error, "");
+  EXPECT_EQ(left.events, events_of(first));
+  EXPECT_EQ(left.sensor, (SensorSize{240, 180}));
+  const ReadAll right = read_all(path, "/dvs_right/events");
+  EXPECT_EQ(right.events, events_of(second));
+}
+
+TEST(Mcap, CorruptCutOrUnclosedFilesGiveTheEventsBeforeThenAnError) {
+  TempDir dir;
+  const auto path = dir.file("bad.mcap");
+  const EventBatch events = sweep_events(200, 3'000'000);
+  std::vector<std::uint8_t> words;
+  detail::make_evt3_encoder({640, 480})->encode(events, words);
+  PacketFields fields;
+  fields.events = words;
+  auto write = [&](bool corrupt_second_chunk, bool close) {
+    McapWriter mcap("lz4");
+    mcap.schema(1, std::string(kRos2EventPacketType));
+    mcap.channel(1, 1, "/events");
+    mcap.message(1, 1, event_packet_cdr(fields));
+    mcap.end_chunk();
+    mcap.message(1, 2, event_packet_cdr(fields));
+    const std::uint64_t second = mcap.end_chunk(corrupt_second_chunk);
+    mcap.finish(path, close);
+    return second;
+  };
+  const std::vector<Event> one = events_of(events);
+
+  std::uint64_t second = write(/*corrupt_second_chunk=*/true, /*close=*/true);
+  ReadAll result = read_all(path);
+  EXPECT_EQ(result.events, one);
+  EXPECT_NE(result.error.find("bad.mcap: byte " + std::to_string(second)), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("CRC mismatch"), std::string::npos) << result.error;
+
+  second = write(false, true);
+  std::filesystem::resize_file(path, second + 30);  // cut inside the second chunk
+  result = read_all(path);
+  EXPECT_EQ(result.events, one);
+  EXPECT_NE(result.error.find("does not fit in the file"), std::string::npos) << result.error;
+
+  write(false, /*close=*/false);  // a recorder that stopped without closing the file
+  result = read_all(path);
+  EXPECT_EQ(result.events.size(), 2 * one.size());
+  EXPECT_NE(result.error.find("without its footer"), std::string::npos) << result.error;
+
+  std::ofstream(path, std::ios::binary) << kMcapMagic << "garbage";
   EXPECT_THROW(read_all(path), FormatError);
 }
 

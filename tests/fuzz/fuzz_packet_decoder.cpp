@@ -1,5 +1,5 @@
 // Fuzz target for the packet decoders of container encodings. The first input byte picks the
-// encoding (evt2, evt3, libcaer, libcaer_cmp, dv_events) and the chunk size, the next 8 bytes are a
+// encoding (evt2, evt3, libcaer, libcaer_cmp, dv_events, dvs_events, mono) and the chunk size, the next 8 bytes are a
 // time base; the rest is one packet, decoded twice. Checks: only FormatError escapes, and for the
 // stream encodings the events do not depend on where chunks are cut (dv_events takes a packet whole).
 
@@ -12,7 +12,7 @@
 
 namespace {
 
-constexpr std::array<const char*, 5> kEncodings = {"evt2", "evt3", "libcaer", "libcaer_cmp", "dv_events"};
+constexpr std::array<const char*, 7> kEncodings = {"evt2", "evt3", "libcaer", "libcaer_cmp", "dv_events", "dvs_events", "mono"};
 
 struct Outcome {
   evldt::EventBatch events;

@@ -1,23 +1,18 @@
 #include "evldt/containers/aedat4.hpp"
 
 #include <flatbuffers/flatbuffers.h>
-#include <lz4frame.h>
-#include <zstd.h>
 
 #include <fstream>
 #include <map>
 #include <stdexcept>
 
 #include "aedat4_header_generated.h"
+#include "decompress.hpp"
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_format.hpp"
 
 namespace evldt {
 namespace {
-
-// A decompressed packet larger than this is refused: no camera writes one, and a forged size must
-// not make the reader allocate without bound.
-constexpr std::size_t kMaxPacketBytes = std::size_t{256} << 20;
 
 /// The streams the XML info node describes: for each "<node ... path=".../outInfo/ID/">" its
 /// attributes, and those of its "info/" child node (sizeX, sizeY, source).
@@ -93,7 +88,7 @@ class Aedat4Source final : public PacketSource {
     std::vector<std::uint8_t> header(4);
     read_exactly(header.data(), 4, "the header size");
     const std::uint32_t header_size = detail::load_le32(header.data());
-    if (header_size > kMaxPacketBytes) throw FormatError(path_, position_ - 4, "header size " + std::to_string(header_size));
+    if (header_size > detail::kMaxDecompressedBytes) throw FormatError(path_, position_ - 4, "header size " + std::to_string(header_size));
     header.resize(4 + header_size);
     read_exactly(header.data() + 4, header_size, "the header");
     flatbuffers::Verifier verifier(header.data(), header.size());
@@ -125,7 +120,7 @@ class Aedat4Source final : public PacketSource {
       read_exactly(header, 8, "a packet header");
       const auto stream = static_cast<std::int32_t>(detail::load_le32(header));
       const std::uint32_t size = detail::load_le32(header + 4);
-      if (size > kMaxPacketBytes || position_ + size > data_end_) {
+      if (size > detail::kMaxDecompressedBytes || position_ + size > data_end_) {
         throw FormatError(path_, at, "packet of " + std::to_string(size) + " bytes does not fit in the file");
       }
       if (stream != stream_id_) {
@@ -178,53 +173,10 @@ class Aedat4Source final : public PacketSource {
     switch (compression_) {
       case aedat4::CompressionType::NONE: out = compressed_; return;
       case aedat4::CompressionType::LZ4:
-      case aedat4::CompressionType::LZ4_HIGH: decompress_lz4(out); return;
+      case aedat4::CompressionType::LZ4_HIGH: detail::decompress_lz4_frame(compressed_, out); return;
       case aedat4::CompressionType::ZSTD:
-      case aedat4::CompressionType::ZSTD_HIGH: decompress_zstd(out); return;
+      case aedat4::CompressionType::ZSTD_HIGH: detail::decompress_zstd_frame(compressed_, out); return;
     }
-  }
-
-  // One LZ4 frame per packet; its content size is optional, so the output grows as needed.
-  void decompress_lz4(std::vector<std::uint8_t>& out) {
-    LZ4F_dctx* context = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&context, LZ4F_VERSION))) throw std::runtime_error("LZ4: out of memory");
-    std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> owner(context, LZ4F_freeDecompressionContext);
-    out.resize(std::max<std::size_t>(compressed_.size() * 4, 1024));
-    std::size_t in_at = 0, out_at = 0;
-    while (true) {
-      std::size_t in_size = compressed_.size() - in_at, out_size = out.size() - out_at;
-      const std::size_t hint = LZ4F_decompress(context, out.data() + out_at, &out_size, compressed_.data() + in_at, &in_size, nullptr);
-      if (LZ4F_isError(hint)) throw std::runtime_error(std::string("LZ4: ") + LZ4F_getErrorName(hint));
-      in_at += in_size;
-      out_at += out_size;
-      if (hint == 0) break;  // the frame is complete
-      if (in_at == compressed_.size() && out_size == 0 && in_size == 0) throw std::runtime_error("LZ4: the frame is cut short");
-      if (out_at == out.size()) grow(out);
-    }
-    out.resize(out_at);
-  }
-
-  void decompress_zstd(std::vector<std::uint8_t>& out) {
-    std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> context(ZSTD_createDCtx(), ZSTD_freeDCtx);
-    if (!context) throw std::runtime_error("Zstandard: out of memory");
-    out.resize(std::max<std::size_t>(compressed_.size() * 4, 1024));
-    ZSTD_inBuffer in{compressed_.data(), compressed_.size(), 0};
-    std::size_t out_at = 0;
-    while (true) {
-      ZSTD_outBuffer output{out.data() + out_at, out.size() - out_at, 0};
-      const std::size_t hint = ZSTD_decompressStream(context.get(), &output, &in);
-      if (ZSTD_isError(hint)) throw std::runtime_error(std::string("Zstandard: ") + ZSTD_getErrorName(hint));
-      out_at += output.pos;
-      if (hint == 0) break;  // the frame is complete
-      if (in.pos == in.size && output.pos < output.size) throw std::runtime_error("Zstandard: the frame is cut short");
-      if (out_at == out.size()) grow(out);
-    }
-    out.resize(out_at);
-  }
-
-  static void grow(std::vector<std::uint8_t>& out) {
-    if (out.size() >= kMaxPacketBytes) throw std::runtime_error("packet decompresses to more than 256 MiB");
-    out.resize(std::min(out.size() * 2, kMaxPacketBytes));
   }
 
   std::string path_;

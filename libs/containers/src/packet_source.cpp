@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "evldt/containers/aedat4.hpp"
+#include "evldt/containers/mcap.hpp"
 #include "evldt/containers/rosbag1.hpp"
 #include "evldt/containers/rosbag2.hpp"
 #include "evldt/events/event_format.hpp"
@@ -60,7 +61,7 @@ bool PacketEventReader::fill(EventBatch& out) {
       decoder_ = make_packet_decoder(packet_.encoding, source_name_ + " " + packet_.location);
       if (!decoder_) {
         throw FormatError(source_name_, 0, packet_.location + ": no decoder for the event encoding '" + packet_.encoding +
-                                               "' (evldt decodes evt2, evt3, libcaer, libcaer_cmp)");
+                                               "' (evldt decodes evt2, evt3, libcaer, libcaer_cmp, mono)");
       }
       encoding_ = packet_.encoding;
     }
@@ -98,6 +99,7 @@ std::unique_ptr<PacketSource> open_packet_container(const std::filesystem::path&
   if (start.starts_with(std::string_view("SQLite format 3\0", 16))) return open_rosbag2(path, topic);
   if (start.starts_with(kAedat4Magic)) return open_aedat4(path);
   if (start.starts_with(kRosbag1Magic)) return open_rosbag1(path, topic);
+  if (start.starts_with(kMcapMagic)) return open_mcap(path, topic);
   return nullptr;
 }
 

@@ -3,53 +3,15 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
-#include <cstring>
 #include <stdexcept>
 
-#include "evldt/containers/rosbag2.hpp"
+#include "evldt/containers/ros_messages.hpp"
 #include "evldt/events/event_format.hpp"
 
 namespace evldt {
 namespace {
 
-// ROS 1 serialization: little-endian, no padding; a string or array is a uint32 count, then the
-// elements.
-class Ros1Reader {
- public:
-  explicit Ros1Reader(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
-  template <typename T>
-  T read() {
-    need(sizeof(T));
-    T value;
-    std::memcpy(&value, bytes_.data() + at_, sizeof(T));
-    at_ += sizeof(T);
-    return value;
-  }
-  std::string read_string() {
-    const auto bytes = read_span(read<std::uint32_t>());
-    return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
-  }
-  std::span<const std::uint8_t> read_span(std::size_t count) {
-    need(count);
-    const auto out = bytes_.subspan(at_, count);
-    at_ += count;
-    return out;
-  }
-
- private:
-  void need(std::size_t count) const {
-    if (count > bytes_.size() - at_) {
-      throw std::runtime_error("message ends early at byte " + std::to_string(at_) + " (" + std::to_string(count) +
-                               " more bytes needed)");
-    }
-  }
-  std::span<const std::uint8_t> bytes_;
-  std::size_t at_ = 0;
-};
-
-constexpr std::size_t kDvsEventBytes = 13;  // uint16 x, uint16 y, time ts (uint32 sec, nsec), uint8 polarity
-
-bool is_event_type(const std::string& type) { return type == kDvsEventArrayType || type == kEventPacketType; }
+bool is_event_type(const std::string& type) { return is_event_message_type(RosSerialization::Ros1, type); }
 
 class Rosbag1Source final : public PacketSource {
  public:
@@ -63,8 +25,8 @@ class Rosbag1Source final : public PacketSource {
         if (!topic_.empty()) continue;
         if (topic.empty() ? is_event_type(connection->datatype) : connection->topic == topic) {
           if (!is_event_type(connection->datatype)) {
-            throw std::runtime_error("topic " + topic + " is of type " + connection->datatype + ", not " + kDvsEventArrayType +
-                                     " or " + kEventPacketType);
+            throw std::runtime_error("topic " + topic + " is of type " + connection->datatype + ", not " +
+                                     std::string(kRos1EventArrayType) + " or " + std::string(kRos1EventPacketType));
           }
           topic_ = connection->topic;
           type_ = connection->datatype;
@@ -92,11 +54,8 @@ class Rosbag1Source final : public PacketSource {
       buffer_.resize(message.size());
       ros::serialization::OStream stream(buffer_.data(), static_cast<std::uint32_t>(buffer_.size()));
       message.write(stream);
-      const Ros1EventMessage decoded = decode_ros1_event_message(message.getDataType(), buffer_);
-      packet.bytes.assign(decoded.events.begin(), decoded.events.end());
-      packet.encoding = decoded.encoding;
-      packet.time_base_ns = static_cast<std::int64_t>(decoded.time_base);
-      packet.sensor = sensor_of(decoded.width, decoded.height);
+      const RosEventMessage decoded = decode_ros_event_message(RosSerialization::Ros1, message.getDataType(), buffer_, scratch_);
+      fill_packet(decoded, packet);
       if (camera_.empty()) camera_ = decoded.frame_id;
       ++read_;
       ++next_;
@@ -123,36 +82,10 @@ class Rosbag1Source final : public PacketSource {
   std::optional<rosbag::View> view_;
   rosbag::View::iterator next_;
   std::uint64_t total_ = 0, read_ = 0;
-  std::vector<std::uint8_t> buffer_;
+  std::vector<std::uint8_t> buffer_, scratch_;
 };
 
 }  // namespace
-
-Ros1EventMessage decode_ros1_event_message(std::string_view type, std::span<const std::uint8_t> bytes) {
-  Ros1Reader reader(bytes);
-  Ros1EventMessage message;
-  reader.read<std::uint32_t>();  // header.seq
-  reader.read<std::uint32_t>();  // header.stamp.sec
-  reader.read<std::uint32_t>();  // header.stamp.nsec
-  message.frame_id = reader.read_string();
-  message.height = reader.read<std::uint32_t>();
-  message.width = reader.read<std::uint32_t>();
-  if (type == kDvsEventArrayType) {
-    const auto count = reader.read<std::uint32_t>();
-    if (count > bytes.size() / kDvsEventBytes) throw std::runtime_error(std::to_string(count) + " events do not fit in the message");
-    message.encoding = "dvs_events";
-    message.events = reader.read_span(std::size_t{count} * kDvsEventBytes);
-  } else if (type == kEventPacketType) {
-    reader.read<std::uint64_t>();  // seq
-    message.time_base = reader.read<std::uint64_t>();
-    message.encoding = reader.read_string();
-    if (reader.read<std::uint8_t>() != 0) throw std::runtime_error("big-endian event data is not supported");
-    message.events = reader.read_span(reader.read<std::uint32_t>());
-  } else {
-    throw std::runtime_error("type " + std::string(type) + " holds no events evldt reads");
-  }
-  return message;
-}
 
 std::unique_ptr<PacketSource> open_rosbag1(const std::filesystem::path& path, const std::string& topic) {
   return std::make_unique<Rosbag1Source>(path, topic);

@@ -27,6 +27,7 @@ std::unique_ptr<EventDecoder> make_packet_decoder(std::string_view encoding, std
   if (encoding == "libcaer_cmp") return detail::make_libcaer_compressed_decoder(std::move(source_name));
   if (encoding == "dv_events") return detail::make_dv_events_decoder(std::move(source_name));
   if (encoding == "dvs_events") return detail::make_dvs_events_decoder(std::move(source_name));
+  if (encoding == "mono") return detail::make_mono_decoder(std::move(source_name));
   return nullptr;
 }
 

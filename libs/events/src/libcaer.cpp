@@ -21,16 +21,11 @@
 namespace evldt::detail {
 namespace {
 
-/// The time base of a packet in us (floor of ns / 1000: time bases may be before 1970, i.e. negative).
-Timestamp time_base_us(std::int64_t time_base_ns) {
-  return time_base_ns / 1000 - (time_base_ns % 1000 < 0 ? 1 : 0);
-}
-
 class LibcaerDecoder final : public EventDecoder {
  public:
   explicit LibcaerDecoder(std::string source) : source_(std::move(source)) {}
   void start_packet(std::int64_t time_base_ns) override {
-    base_us_ = time_base_us(time_base_ns);
+    base_us_ = floor_ns_to_us(time_base_ns);
     wrap_us_ = 0;
     last_time_ = 0;
   }
@@ -69,7 +64,7 @@ class LibcaerCompressedDecoder final : public EventDecoder {
  public:
   explicit LibcaerCompressedDecoder(std::string source) : source_(std::move(source)) {}
   void start_packet(std::int64_t time_base_ns) override {
-    base_us_ = time_base_us(time_base_ns);
+    base_us_ = floor_ns_to_us(time_base_ns);
     time_high_ = 0;
     time_low_ = 0;
   }

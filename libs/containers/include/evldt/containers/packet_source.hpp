@@ -1,5 +1,5 @@
 #pragma once
-// Containers of event recordings (ROS 1 and 2 bags, AEDAT 4 files) kept apart from the encodings of their
+// Containers of event recordings (ROS 1 and 2 bags, MCAP, AEDAT 4 files) kept apart from the encodings of their
 // events: a container yields packets with their metadata, and the decoder that the packet's encoding
 // names (libs/events, make_packet_decoder) turns them into events.
 
@@ -81,7 +81,7 @@ class PacketEventReader {
 };
 
 /// The container `path` holds, recognised by its first bytes (SQLite for a ROS 2 bag, "#ROSBAG V2.0"
-/// for a ROS 1 bag, "#!AER-DAT4.0" for AEDAT 4), or nullptr for a file that is none. `topic` picks a bag's topic (empty: the first
+/// for a ROS 1 bag, "\x89MCAP0" for MCAP, "#!AER-DAT4.0" for AEDAT 4), or nullptr for a file that is none. `topic` picks a bag's topic (empty: the first
 /// with an event message type). Throws std::runtime_error / FormatError for a container it cannot use.
 std::unique_ptr<PacketSource> open_packet_container(const std::filesystem::path& path, const std::string& topic);
 

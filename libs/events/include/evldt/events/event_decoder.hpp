@@ -71,8 +71,8 @@ std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string sourc
 /// The decoder of one packet encoding of a container, by the name the container gives it
 /// (event_camera_msgs' encoding field): "evt2", "evt3" (bare Prophesee words, one stream across
 /// packets), "libcaer", "libcaer_cmp" (iniVation, time from each packet's time base), "dv_events"
-/// (an AEDAT 4.0 polarity packet, handed whole), "dvs_events" (a ROS 1 dvs_msgs/EventArray's
-/// records); nullptr for an encoding evldt does not decode.
+/// (an AEDAT 4.0 polarity packet, handed whole), "dvs_events" (a dvs_msgs/EventArray's records),
+/// "mono" (event_camera_codecs' plain 64-bit events); nullptr for an encoding evldt does not decode.
 /// Packet offsets in errors are relative to the packet.
 std::unique_ptr<EventDecoder> make_packet_decoder(std::string_view encoding, std::string source_name);
 
@@ -91,6 +91,10 @@ std::unique_ptr<EventDecoder> make_libcaer_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_compressed_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_dv_events_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_dvs_events_decoder(std::string source_name);
+std::unique_ptr<EventDecoder> make_mono_decoder(std::string source_name);
+
+/// A time in ns as evldt's us, rounded down (container time bases may be before 1970: negative).
+inline Timestamp floor_ns_to_us(std::int64_t ns) { return ns / 1000 - (ns % 1000 < 0 ? 1 : 0); }
 
 /// The text header that recordings start with: lines beginning with a marker, '%' (Prophesee RAW and
 /// dat) or '#' (AEDAT 2.0 / 3.1). It ends at the first line that does not start with the marker (the

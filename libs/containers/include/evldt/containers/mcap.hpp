@@ -1,0 +1,23 @@
+#pragma once
+// MCAP files (.mcap; rosbag2's default storage since ROS 2 Iron, Foxglove): the messages of one
+// event topic, in file order (the order the recorder wrote them), as packets. Chunks may be
+// uncompressed, LZ4 or Zstandard; their CRC is checked. Channels in CDR ("ros2msg" schemas) or ROS 1
+// serialization ("ros1msg") with an event message type (ros_messages.hpp) are read.
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "evldt/containers/packet_source.hpp"
+
+namespace evldt {
+
+inline constexpr std::string_view kMcapMagic{"\x89MCAP0\r\n", 8};
+
+/// Opens an MCAP file and reads up to the channel to use. `topic` empty: the first channel of an
+/// event type. Throws std::runtime_error naming the file if it is no MCAP file or has no such
+/// channel (listing its channels).
+std::unique_ptr<PacketSource> open_mcap(const std::filesystem::path& path, const std::string& topic);
+
+}  // namespace evldt

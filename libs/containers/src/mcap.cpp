@@ -1,0 +1,261 @@
+#include "evldt/containers/mcap.hpp"
+
+#include <zlib.h>
+
+#include <fstream>
+#include <map>
+#include <stdexcept>
+#include <vector>
+
+#include "decompress.hpp"
+#include "evldt/containers/ros_messages.hpp"
+#include "evldt/events/event_decoder.hpp"
+#include "evldt/events/event_format.hpp"
+
+namespace evldt {
+namespace {
+
+// The record types read here (MCAP specification, major version 0); the others are skipped.
+enum Opcode : std::uint8_t { kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kChunk = 0x06, kDataEnd = 0x0F };
+
+/// Fields of a record's content: little-endian integers, strings and byte arrays with a length prefix.
+class FieldReader {
+ public:
+  explicit FieldReader(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
+  template <typename T>
+  T read() {
+    const auto raw = take(sizeof(T));
+    std::uint64_t value = 0;
+    for (std::size_t i = 0; i < sizeof(T); ++i) value |= std::uint64_t{raw[i]} << (8 * i);
+    return static_cast<T>(value);
+  }
+  std::string read_string() {
+    const auto text = take(read<std::uint32_t>());
+    return {reinterpret_cast<const char*>(text.data()), text.size()};
+  }
+  std::span<const std::uint8_t> take(std::uint64_t count) {
+    if (count > bytes_.size() - at_) throw std::runtime_error("record ends inside a field");
+    const auto out = bytes_.subspan(at_, count);
+    at_ += count;
+    return out;
+  }
+  [[nodiscard]] std::span<const std::uint8_t> rest() const { return bytes_.subspan(at_); }
+
+ private:
+  std::span<const std::uint8_t> bytes_;
+  std::size_t at_ = 0;
+};
+
+struct Record {
+  std::uint8_t opcode = 0;
+  std::span<const std::uint8_t> content;
+  std::uint64_t offset = 0;  ///< in the file: the record's, or its chunk's
+  bool in_chunk = false;
+};
+
+struct Channel {
+  std::string topic, type, encoding;
+};
+
+class McapSource final : public PacketSource {
+ public:
+  McapSource(const std::filesystem::path& path, const std::string& topic)
+      : path_(path.string()), wanted_(topic), file_(path, std::ios::binary) {
+    if (!file_) throw std::runtime_error("cannot open MCAP file '" + path_ + "'");
+    std::error_code size_error;
+    file_size_ = std::filesystem::file_size(path, size_error);
+    std::string magic(kMcapMagic.size(), '\0');
+    read_exactly(magic.data(), magic.size(), "the magic");
+    if (magic != kMcapMagic) throw FormatError(path_, 0, "not an MCAP file");
+    // A channel is described before its first message: read on until the one to use.
+    Record record;
+    while (channel_id_ < 0 && next_record(record)) handle(record);
+    if (channel_id_ < 0) {
+      std::string listing;
+      for (const auto& entry : channels_) {
+        listing += (listing.empty() ? "" : ", ") + entry.second.topic + " (" + entry.second.type + ", " + entry.second.encoding + ")";
+      }
+      throw std::runtime_error("'" + path_ + "': " + (wanted_.empty() ? std::string("no channel of an event type") : "no channel " + wanted_) +
+                               " (channels: " + (listing.empty() ? "none" : listing) + ")");
+    }
+  }
+
+  bool next(RecordingPacket& packet) override {
+    Record record;
+    while (next_record(record)) {
+      if (!handle(record)) continue;
+      packet.location = "message " + std::to_string(read_) + " of " + topic_ + " (record at byte " + std::to_string(record.offset) + ")";
+      try {
+        FieldReader fields(record.content);
+        fields.take(2 + 4 + 8 + 8);  // channel id, sequence, log time, publish time
+        const RosEventMessage message = decode_ros_event_message(serialization_, type_, fields.rest(), scratch_);
+        fill_packet(message, packet);
+        if (camera_.empty()) camera_ = message.frame_id;
+      } catch (const std::runtime_error& error) {
+        throw FormatError(path_, record.offset, packet.location + ": " + error.what());
+      }
+      ++read_;
+      return true;
+    }
+    return false;
+  }
+
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return std::nullopt; }  // in the messages
+  [[nodiscard]] std::string camera() const override { return camera_; }
+  [[nodiscard]] std::string description() const override { return "MCAP, " + topic_ + " (" + type_ + ")"; }
+  [[nodiscard]] double progress() const override {
+    return file_size_ == 0 ? 1.0 : static_cast<double>(position_) / static_cast<double>(file_size_);
+  }
+  [[nodiscard]] std::uint64_t skipped_packets() const override { return skipped_; }
+
+ private:
+  /// The next record of the data section, from the current chunk or the file; false at its end.
+  bool next_record(Record& record) {
+    if (chunk_at_ < chunk_.size()) {
+      FieldReader header{std::span<const std::uint8_t>(chunk_).subspan(chunk_at_)};
+      try {
+        record.opcode = header.read<std::uint8_t>();
+        record.content = header.take(header.read<std::uint64_t>());
+      } catch (const std::runtime_error&) {
+        throw FormatError(path_, chunk_offset_, "a record inside the chunk at byte " + std::to_string(chunk_offset_) + " runs past its end");
+      }
+      record.offset = chunk_offset_;
+      record.in_chunk = true;
+      chunk_at_ += 9 + record.content.size();
+      return true;
+    }
+    if (at_end_) return false;
+    std::uint8_t header[9];
+    record.offset = position_;
+    if (position_ == file_size_) throw FormatError(path_, position_, "file ends without its footer (a recording cut short)");
+    read_exactly(header, sizeof header, "a record header");
+    FieldReader fields{std::span<const std::uint8_t>(header)};
+    record.opcode = fields.read<std::uint8_t>();
+    const auto length = fields.read<std::uint64_t>();
+    if (length > file_size_ - position_ || length > detail::kMaxDecompressedBytes) {
+      throw FormatError(path_, record.offset, "record of " + std::to_string(length) + " bytes does not fit in the file (a recording cut short?)");
+    }
+    file_record_.resize(length);
+    read_exactly(file_record_.data(), length, "a record");
+    record.content = file_record_;
+    record.in_chunk = false;
+    if (record.opcode == kDataEnd || record.opcode == kFooter) {
+      at_end_ = true;  // the summary after it repeats schemas and channels, and has no messages
+      return false;
+    }
+    return true;
+  }
+
+  /// Takes in a record: schemas, channels, chunks. True for a message of the chosen channel.
+  bool handle(const Record& record) {
+    try {
+      FieldReader fields(record.content);
+      switch (record.opcode) {
+        case kSchema: {
+          const auto id = fields.read<std::uint16_t>();
+          schemas_[id] = fields.read_string();
+          return false;
+        }
+        case kChannel: {
+          const auto id = fields.read<std::uint16_t>();
+          const auto schema = fields.read<std::uint16_t>();
+          Channel channel{fields.read_string(), {}, {}};
+          channel.encoding = fields.read_string();
+          const auto found = schemas_.find(schema);
+          channel.type = found == schemas_.end() ? "no schema" : found->second;
+          consider(id, channel);
+          channels_[id] = std::move(channel);
+          return false;
+        }
+        case kMessage: {
+          if (fields.read<std::uint16_t>() == channel_id_ && channel_id_ >= 0) return true;
+          ++skipped_;
+          return false;
+        }
+        case kChunk:
+          if (record.in_chunk) throw std::runtime_error("a chunk inside a chunk");
+          open_chunk(fields, record.offset);
+          return false;
+        default: return false;
+      }
+    } catch (const FormatError&) {
+      throw;
+    } catch (const std::runtime_error& error) {
+      throw FormatError(path_, record.offset, "record type " + std::to_string(record.opcode) + " at byte " +
+                                                  std::to_string(record.offset) + ": " + error.what());
+    }
+  }
+
+  void consider(std::uint16_t id, const Channel& channel) {
+    if (channel_id_ >= 0) return;
+    const bool ros1 = channel.encoding == "ros1", cdr = channel.encoding == "cdr";
+    const RosSerialization serialization = ros1 ? RosSerialization::Ros1 : RosSerialization::Cdr;
+    const bool events = (ros1 || cdr) && is_event_message_type(serialization, channel.type);
+    if (!(wanted_.empty() ? events : channel.topic == wanted_)) return;
+    if (!events) {
+      throw std::runtime_error("'" + path_ + "': channel " + channel.topic + " is of type " + channel.type + " (" + channel.encoding +
+                               "), not an event type evldt reads");
+    }
+    channel_id_ = id;
+    topic_ = channel.topic;
+    type_ = channel.type;
+    serialization_ = serialization;
+  }
+
+  void open_chunk(FieldReader& fields, std::uint64_t offset) {
+    fields.take(8 + 8);  // message start and end time
+    const auto size = fields.read<std::uint64_t>();
+    const auto crc = fields.read<std::uint32_t>();
+    const std::string compression = fields.read_string();
+    const auto records = fields.take(fields.read<std::uint64_t>());
+    if (compression.empty()) {
+      chunk_.assign(records.begin(), records.end());
+    } else if (compression == "lz4") {
+      detail::decompress_lz4_frame(records, chunk_);
+    } else if (compression == "zstd") {
+      detail::decompress_zstd_frame(records, chunk_);
+    } else {
+      throw std::runtime_error("unknown chunk compression '" + compression + "'");
+    }
+    if (chunk_.size() != size) {
+      throw std::runtime_error("chunk holds " + std::to_string(chunk_.size()) + " bytes, its header says " + std::to_string(size));
+    }
+    if (crc != 0 && crc32(0, chunk_.data(), static_cast<uInt>(chunk_.size())) != crc) {
+      throw std::runtime_error("chunk CRC mismatch (a corrupt file)");
+    }
+    chunk_at_ = 0;
+    chunk_offset_ = offset;
+  }
+
+  void read_exactly(void* out, std::size_t size, const char* what) {
+    file_.read(static_cast<char*>(out), static_cast<std::streamsize>(size));
+    if (static_cast<std::size_t>(file_.gcount()) != size) {
+      throw FormatError(path_, position_ + static_cast<std::uint64_t>(file_.gcount()), std::string("file ends inside ") + what);
+    }
+    position_ += size;
+  }
+
+  std::string path_, wanted_;
+  std::ifstream file_;
+  std::uint64_t file_size_ = 0, position_ = 0;
+  bool at_end_ = false;
+  std::vector<std::uint8_t> file_record_;
+  std::vector<std::uint8_t> chunk_;
+  std::size_t chunk_at_ = 0;
+  std::uint64_t chunk_offset_ = 0;
+  std::map<std::uint16_t, std::string> schemas_;
+  std::map<std::uint16_t, Channel> channels_;
+  int channel_id_ = -1;
+  std::string topic_, type_, camera_;
+  RosSerialization serialization_ = RosSerialization::Cdr;
+  std::vector<std::uint8_t> scratch_;
+  std::uint64_t read_ = 0, skipped_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<PacketSource> open_mcap(const std::filesystem::path& path, const std::string& topic) {
+  return std::make_unique<McapSource>(path, topic);
+}
+
+}  // namespace evldt
