@@ -4,6 +4,7 @@
 // Zstandard packets), and on the real recordings in ../shared/real when they are there.
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <lz4frame.h>
 #include <rosbag/bag.h>
 #include <sqlite3.h>
@@ -715,7 +716,7 @@ TEST(Mcap, EventPacketsInChunksOfEveryCompressionOrNone) {
   const EventBatch events = sweep_events(4000, 9'000'000);
   std::vector<std::uint8_t> words;
   detail::make_evt3_encoder({640, 480})->encode(events, words);
-  for (const std::optional<std::string> compression : {std::optional<std::string>(), std::optional<std::string>(""),
+  for (const std::optional<std::string>& compression : {std::optional<std::string>(), std::optional<std::string>(""),
                                                        std::optional<std::string>("lz4"), std::optional<std::string>("zstd")}) {
     SCOPED_TRACE(compression.value_or("no chunks"));
     McapWriter mcap(compression);
@@ -818,6 +819,203 @@ TEST(Mcap, CorruptCutOrUnclosedFilesGiveTheEventsBeforeThenAnError) {
 
   std::ofstream(path, std::ios::binary) << kMcapMagic << "garbage";
   EXPECT_THROW(read_all(path), FormatError);
+}
+
+// ---- HDF5 -----------------------------------------------------------------------------------------
+
+/// HDF5 fixtures written with the HDF5 C library, in the layouts of DSEC, MVSEC and Metavision.
+class Hdf5Writer {
+ public:
+  explicit Hdf5Writer(const std::filesystem::path& path) : file_(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT)) {
+    EXPECT_GE(file_, 0);
+  }
+  ~Hdf5Writer() { H5Fclose(file_); }
+  void group(const char* name) { H5Gclose(H5Gcreate2(file_, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)); }
+  /// A dataset of `dims` rows (x columns) of `file_type` from `data` of `memory_type`, in chunks
+  /// through `filter` (0: none).
+  void dataset(const char* name, hid_t file_type, hid_t memory_type, const void* data, std::vector<hsize_t> dims, H5Z_filter_t filter = 0,
+               unsigned filter_flags = H5Z_FLAG_MANDATORY) {
+    const hid_t space = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+    const hid_t plist = H5Pcreate(H5P_DATASET_CREATE);
+    if (filter != 0) {
+      std::vector<hsize_t> chunk = dims;
+      chunk[0] = std::min<hsize_t>(dims[0], 10000);
+      H5Pset_chunk(plist, static_cast<int>(chunk.size()), chunk.data());
+      const unsigned blosc_options[7] = {0, 0, 0, 0, 5, 1, 0};  // level 5, byte shuffle, blosclz
+      EXPECT_GE(H5Pset_filter(plist, filter, filter_flags, 7, blosc_options), 0);
+    }
+    const hid_t dataset = H5Dcreate2(file_, name, file_type, space, H5P_DEFAULT, plist, H5P_DEFAULT);
+    EXPECT_GE(dataset, 0) << name;
+    EXPECT_GE(H5Dwrite(dataset, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), 0) << name;
+    H5Dclose(dataset);
+    H5Pclose(plist);
+    H5Sclose(space);
+  }
+  void string_attribute(const char* name, const std::string& value) {
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, value.size() + 1);
+    const hid_t space = H5Screate(H5S_SCALAR);
+    const hid_t attribute = H5Acreate2(file_, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(attribute, type, value.c_str());
+    H5Aclose(attribute);
+    H5Sclose(space);
+    H5Tclose(type);
+  }
+  [[nodiscard]] hid_t file() const { return file_; }
+
+ private:
+  hid_t file_;
+};
+
+constexpr H5Z_filter_t kBlosc = 32001;
+
+/// DSEC's layout: /events/{x, y, t, p} (t in us from /t_offset), blosc-compressed, and /ms_to_idx.
+void write_dsec(const std::filesystem::path& path, const EventBatch& events, std::int64_t t_offset) {
+  Hdf5Writer h5(path);
+  h5.group("/events");
+  std::vector<std::uint32_t> t;
+  std::vector<std::uint8_t> p;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    t.push_back(static_cast<std::uint32_t>(events.t[i] - t_offset));
+    p.push_back(events.p[i] > 0 ? 1 : 0);
+  }
+  const std::vector<hsize_t> n{events.size()};
+  h5.dataset("/events/x", H5T_STD_U16LE, H5T_NATIVE_UINT16, events.x.data(), n, kBlosc);
+  h5.dataset("/events/y", H5T_STD_U16LE, H5T_NATIVE_UINT16, events.y.data(), n, kBlosc);
+  h5.dataset("/events/t", H5T_STD_U32LE, H5T_NATIVE_UINT32, t.data(), n, kBlosc);
+  h5.dataset("/events/p", H5T_STD_U8LE, H5T_NATIVE_UINT8, p.data(), n, kBlosc);
+  h5.dataset("/t_offset", H5T_STD_I64LE, H5T_NATIVE_INT64, &t_offset, {1});
+  const std::vector<std::uint64_t> ms_to_idx{0, events.size()};
+  h5.dataset("/ms_to_idx", H5T_STD_U64LE, H5T_NATIVE_UINT64, ms_to_idx.data(), {2});
+}
+
+TEST(Hdf5, DsecColumnsThroughTheBloscPluginInSlabs) {
+  TempDir dir;
+  const auto path = dir.file("events.h5");
+  const std::int64_t t_offset = 1'500'000'000'000'000;
+  EventBatch events;
+  for (int i = 0; i < 150'000; ++i) {  // more than two slabs
+    events.push_back(t_offset + 2 * i + 40, static_cast<std::uint16_t>((13 * i) % 640), static_cast<std::uint16_t>((7 * i) % 480), i % 3 ? 1 : -1);
+  }
+  write_dsec(path, events, t_offset);
+  {  // the fixture is blosc-compressed, so the plugin was found and used
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    const hid_t dataset = H5Dopen2(file, "/events/t", H5P_DEFAULT);
+    const hid_t plist = H5Dget_create_plist(dataset);
+    EXPECT_EQ(H5Pget_nfilters(plist), 1);
+    EXPECT_EQ(H5Pget_filter2(plist, 0, nullptr, nullptr, nullptr, 0, nullptr, nullptr), kBlosc);
+    H5Pclose(plist);
+    H5Dclose(dataset);
+    H5Fclose(file);
+  }
+  const ReadAll result = read_all(path);
+  EXPECT_EQ(result.error, "");
+  EXPECT_EQ(result.events, events_of(events));
+  EXPECT_EQ(result.sensor, (SensorSize{640, 480}));
+  EXPECT_NE(result.name.find("HDF5, /events (columns x, y, t, p, t in us; 640x480 as DSEC's cameras: not in the file)"), std::string::npos)
+      << result.name;
+}
+
+TEST(Hdf5, MvsecRowsInSecondsEitherCameraAndMetavisionRecords) {
+  TempDir dir;
+  const auto path = dir.file("mvsec_data.hdf5");
+  std::vector<double> left, right;
+  for (int i = 0; i < 1000; ++i) {
+    for (const double value : {double(i % 346), double(i % 260), 1'504'645'177.5 + i * 1e-5, i % 2 ? 1.0 : -1.0}) left.push_back(value);
+    for (const double value : {double(i % 200), 3.0, 1'504'645'180.0 + i * 1e-6, 1.0}) right.push_back(value);
+  }
+  {
+    Hdf5Writer h5(path);
+    h5.group("/davis");
+    h5.group("/davis/left");
+    h5.group("/davis/right");
+    h5.dataset("/davis/left/events", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, left.data(), {1000, 4});
+    h5.dataset("/davis/right/events", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, right.data(), {1000, 4});
+  }
+  const ReadAll result = read_all(path);
+  EXPECT_EQ(result.error, "");
+  ASSERT_EQ(result.events.size(), 1000u);
+  EXPECT_EQ(result.events[0], (Event{1'504'645'177'500'000, 0, 0, -1}));
+  EXPECT_EQ(result.events[999], (Event{1'504'645'177'500'000 + 9990, 999 % 346, 999 % 260, 1}));
+  EXPECT_EQ(result.sensor, (SensorSize{346, 260}));
+  const ReadAll other = read_all(path, "davis/right/events");
+  ASSERT_EQ(other.events.size(), 1000u);
+  EXPECT_EQ(other.events[7], (Event{1'504'645'180'000'007, 7, 3, 1}));
+
+  // Metavision's records, sensor size from its geometry attribute; an x off the sensor is kept for the
+  // validator to drop and count.
+  struct CdEvent {
+    std::uint16_t x, y;
+    std::int16_t p;
+    std::int64_t t;
+  };
+  const std::vector<CdEvent> cd{{1279, 719, 1, 100}, {0, 0, 0, 250}, {70000 % 65536, 5, 1, 300}};
+  const auto records = dir.file("recording.hdf5");
+  {
+    Hdf5Writer h5(records);
+    h5.group("/CD");
+    const hid_t type = H5Tcreate(H5T_COMPOUND, sizeof(CdEvent));
+    H5Tinsert(type, "x", HOFFSET(CdEvent, x), H5T_NATIVE_UINT16);
+    H5Tinsert(type, "y", HOFFSET(CdEvent, y), H5T_NATIVE_UINT16);
+    H5Tinsert(type, "p", HOFFSET(CdEvent, p), H5T_NATIVE_INT16);
+    H5Tinsert(type, "t", HOFFSET(CdEvent, t), H5T_NATIVE_INT64);
+    h5.dataset("/CD/events", type, type, cd.data(), {cd.size()});
+    H5Tclose(type);
+    h5.string_attribute("geometry", "1280x720");
+  }
+  const ReadAll metavision = read_all(records);
+  EXPECT_EQ(metavision.error, "");
+  EXPECT_EQ(metavision.events, (std::vector<Event>{{100, 1279, 719, 1}, {250, 0, 0, -1}, {300, 70000 % 65536, 5, 1}}));
+  EXPECT_EQ(metavision.sensor, (SensorSize{1280, 720}));
+}
+
+TEST(Hdf5, MissingTablesFiltersOrBytesAreClearErrors) {
+  TempDir dir;
+  const auto path = dir.file("odd.h5");
+  std::vector<double> values(40, 1.0);
+  values[0] = -5;  // an x no uint16 holds: off every sensor
+  {
+    Hdf5Writer h5(path);
+    h5.dataset("/images", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, values.data(), {10, 4});
+  }
+  try {
+    read_all(path);
+    ADD_FAILURE() << "no event table";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("no event table"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("odd.h5"), std::string::npos) << error.what();
+  }
+  const ReadAll named = read_all(path, "/images");  // any N x 4 table, by name
+  ASSERT_EQ(named.events.size(), 10u);
+  EXPECT_EQ(named.events[0].x, 65535);
+
+  // A filter that is not installed (Prophesee's ECF): refused at once, saying what to install.
+  const std::vector<std::uint16_t> column(100, 1);
+  {
+    Hdf5Writer h5(path);
+    h5.group("/events");
+    for (const char* name : {"/events/x", "/events/y", "/events/t", "/events/p"}) {
+      h5.dataset(name, H5T_STD_U16LE, H5T_NATIVE_UINT16, column.data(), {column.size()}, 0x8ECF, H5Z_FLAG_OPTIONAL);
+    }
+  }
+  try {
+    read_all(path);
+    ADD_FAILURE() << "a filter that is not installed";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("not packaged by Debian"), std::string::npos) << error.what();
+  }
+
+  // A file cut short.
+  const EventBatch events = sweep_events(100'000, 1000);
+  write_dsec(path, events, 0);
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) / 2);
+  try {
+    const ReadAll cut = read_all(path);
+    EXPECT_LT(cut.events.size(), events.size());
+    EXPECT_NE(cut.error.find("odd.h5"), std::string::npos) << cut.error;
+  } catch (const std::runtime_error& error) {  // HDF5 refuses to open it: its superblock says how long it is
+    EXPECT_NE(std::string(error.what()).find("odd.h5': HDF5 cannot open it: truncated file"), std::string::npos) << error.what();
+  }
 }
 
 // ---- real recordings ------------------------------------------------------------------------------

@@ -5,16 +5,20 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <thread>
 
+#include "evldt/events/event_writer.hpp"
 #include "evldt/nodes/camera_node.hpp"
 #include "evldt/nodes/lines_node.hpp"
 #include "evldt/nodes/viz_node.hpp"
 #include "evldt/sim/scenes.hpp"
+#include "evldt/transport/channels.hpp"
 #include "evldt/transport/messages.hpp"
+#include "support/temp_dir.hpp"
 
 namespace evldt {
 namespace {
@@ -166,6 +170,56 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
     }
   }
   EXPECT_GE(most_segments, 10u);  // boxes-6dof shows some 20 edges
+}
+
+// Every statistics message a service publishes.
+class StatsCollector {
+ public:
+  explicit StatsCollector(lcm::LCM& lcm) { lcm.subscribe(std::string(kStatsChannel), &StatsCollector::on_stats, this); }
+  void on_stats(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    stats_t msg;
+    const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size);
+    if (decode_message(bytes, msg) == WireError::None) messages_.push_back(msg);
+  }
+  std::vector<stats_t> messages_;
+};
+
+TEST(Nodes, CameraStatisticsCountTheWordsItsDecoderSkipped) {
+  // An EVT 3.0 recording padded with 0x9999 words, as some IMX636 cameras write it.
+  test_support::TempDir dir;
+  const auto path = dir.file("padded.raw");
+  EventBatch events;
+  for (int i = 0; i < 5000; ++i) events.push_back(1000 + 20 * i, static_cast<std::uint16_t>(i % 640), static_cast<std::uint16_t>(i % 480), 1);
+  std::vector<std::uint8_t> words;
+  detail::make_evt3_encoder({640, 480})->encode(events, words);
+  std::string file = "% format EVT3;height=480;width=640\n% end\n";
+  int padding = 0;
+  for (std::size_t at = 0; at < words.size(); at += 2) {
+    if (at % 200 == 0) {
+      file += "\x99\x99";
+      ++padding;
+    }
+    file.append(reinterpret_cast<const char*>(words.data() + at), 2);
+  }
+  std::ofstream(path, std::ios::binary) << file;
+
+  lcm::LCM lcm("memq://");
+  StatsCollector stats(lcm);
+  CameraNode camera(lcm, fast_camera(), 77);
+  const std::atomic<bool> never{false};
+  const CameraSummary sent = camera.run([&] { return open_recording(path, std::nullopt, "", 1000); }, never);
+  EXPECT_EQ(sent.events_published, events.size());
+  EXPECT_EQ(sent.decoded.skipped_words, static_cast<std::uint64_t>(padding));
+  while (lcm.handleTimeout(0) > 0) {
+  }
+  ASSERT_FALSE(stats.messages_.empty());
+  const stats_t& last = stats.messages_.back();  // the one at the end of the run
+  EXPECT_EQ(last.service, "evldt-camera");
+  EXPECT_EQ(last.source, "cam0");
+  EXPECT_EQ(last.words_skipped, padding);
+  EXPECT_EQ(last.trigger_events, 0);
+  EXPECT_EQ(last.events_in, static_cast<std::int64_t>(events.size()));
+  EXPECT_EQ(last.batches_received, static_cast<std::int64_t>(sent.batches));
 }
 
 TEST(Nodes, GarbageAndForeignMessagesAreCountedNotFatal) {

@@ -96,7 +96,7 @@ cat "$work/relay.out" "$work/lines3.out" "$work/viz.out"
 dropped=$(field "$work/relay.out" 'dropped')
 lost=$(grep -oP 'received, \K[0-9]+(?= lost)' "$work/lines3.out")
 check "evldt-lines counted every dropped batch as lost ($lost of $dropped)" test "${lost:-x}" = "$dropped" -a "$dropped" -gt 0
-stats_lost=$(awk '$1 == "stats" { v = $5 } END { print v + 0 }' "$work/probe2.out")
+stats_lost=$(awk '$1 == "stats" && $3 == "evldt-lines" { v = $6 } END { print v + 0 }' "$work/probe2.out")
 check "its statistics messages report the loss ($stats_lost)" test "$stats_lost" -gt 0
 check "every segment list heard was valid" test "$(grep -c '^invalid' "$work/probe2.out")" -eq 0
 # Not slowed: evldt-lines published as many lists a second while the viz was stopped as over the

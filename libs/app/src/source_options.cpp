@@ -8,13 +8,15 @@ namespace evldt {
 
 void SourceOptions::add_to(CLI::App& app) {
   app.add_option("input", recording_,
-                 "Recording: Prophesee RAW (EVT 2.0/2.1/3.0) or .dat, ECD events.txt, a ROS 1 or 2 bag, AEDAT 2.0/3.1/4.0, or an\n"
-                 "lcm-log of event batches; the format and sensor size come from the file")
+                 "Recording: Prophesee RAW (EVT 2.0/2.1/3.0) or .dat, ECD events.txt, a ROS 1 or 2 bag (.bag, .db3, .mcap),\n"
+                 "AEDAT 2.0/3.1/4.0, Event Stream .es, HDF5 (DSEC, MVSEC, Metavision), or an lcm-log of event batches;\n"
+                 "the format and sensor size come from the file")
       ->check(CLI::ExistingFile);
   app.add_option("--format", format_, "Recording format when the name does not tell: ecd, evt2, evt3, evt21, dat")
       ->check(CLI::IsMember({"ecd", "evt2", "evt3", "evt21", "dat"}));
   app.add_option("--lcm-channel,--topic", lcm_channel_,
-                 "Event channel of an lcm-log, or topic of a ROS 2 bag (default: the first EVENTS_* channel / event topic)");
+                 "Event channel of an lcm-log, topic of a bag or MCAP file, or event table of an HDF5 file (default: the\n"
+                 "first EVENTS_* channel / event topic / of /events, /davis/left/events, /CD/events)");
   app.add_option("--from-video", video_,
                  "Video file or webcam index: events by frame differencing (thresholds: --contrast, --contrast-sigma, "
                  "--refractory-us, --seed)");

@@ -71,10 +71,24 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   spdlog::info("publishing {} ({}x{}) on {} at {}", source->name(), sensor->width, sensor->height, channel_,
                options_.speed > 0 ? fmt::format("{}x real time", options_.speed) : std::string("full speed"));
 
+  auto last_stats = started;
+  std::uint64_t published_at_last_stats = 0;
+  const auto stats = [&](bool final) {
+    const auto now = Clock::now();
+    const double period_s = std::chrono::duration<double>(now - last_stats).count();
+    if (options_.stats_hz <= 0 || (!final && period_s < 1.0 / options_.stats_hz)) return;
+    DecodeCounts decoded = summary.decoded;
+    if (!final) decoded += source->decode_counts();  // at the end, summary.decoded holds them all
+    publish_stats(summary, decoded, final ? summary.drops : validator.drops(), period_s,
+                  summary.events_published - published_at_last_stats);
+    last_stats = now;
+    published_at_last_stats = summary.events_published;
+  };
   const auto publish_ready = [&](bool flush) {
     while (!stop.load() && batcher.pop(batch, flush)) {
       summary.max_lag_s = std::max(summary.max_lag_s, pacer.wait_until(batch.t.back(), stop));
       publish(batch, summary);
+      stats(false);
     }
   };
   try {
@@ -117,7 +131,26 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   summary.drops = validator.drops();
   summary.skipped_gaps = pacer.skipped_gaps();
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  stats(true);
   return summary;
+}
+
+void CameraNode::publish_stats(const CameraSummary& summary, const DecodeCounts& decoded, const DropCounts& drops,
+                               double period_s, std::uint64_t rate_events) {
+  stats_t msg{};
+  msg.utime = wall_clock_us();
+  msg.epoch = epoch_us_;
+  msg.service = "evldt-camera";
+  msg.source = options_.camera;
+  msg.period_s = period_s;
+  msg.events_in = static_cast<std::int64_t>(summary.events_read);
+  msg.event_rate = period_s > 0 ? static_cast<double>(rate_events) / period_s : 0.0;
+  msg.events_dropped = static_cast<std::int64_t>(drops.total());
+  msg.batches_received = static_cast<std::int64_t>(summary.batches);
+  msg.batches_lost = static_cast<std::int64_t>(summary.publish_failures);
+  msg.words_skipped = static_cast<std::int64_t>(decoded.skipped_words);
+  msg.trigger_events = static_cast<std::int64_t>(decoded.trigger_events);
+  lcm_.publish(std::string(kStatsChannel), &msg);
 }
 
 void CameraNode::publish(const EventBatch& batch, CameraSummary& summary) {

@@ -162,7 +162,7 @@ void LinesNode::publish_stats(double period_s) {
   const auto rate = [&](std::uint64_t current, std::uint64_t before) {
     return static_cast<double>(current - before) / period_s;
   };
-  stats_t msg;
+  stats_t msg{};
   msg.utime = wall_clock_us();
   msg.epoch = epoch_us_;
   msg.service = "evldt-lines";

@@ -66,8 +66,9 @@ void VizNode::on_lines(const lcm::ReceiveBuffer* buffer, const std::string&) {
 }
 
 void VizNode::on_stats(const lcm::ReceiveBuffer* buffer, const std::string&) {
-  // Statistics of other cameras' lines services share the channel: keep only ours.
-  if (decode_message(payload_of(buffer), stats_msg_) == WireError::None && stats_msg_.source == options_.camera) {
+  // Other cameras' services and our camera service share the channel: keep our lines service's.
+  if (decode_message(payload_of(buffer), stats_msg_) == WireError::None && stats_msg_.source == options_.camera &&
+      stats_msg_.service == "evldt-lines") {
     stats_ = stats_msg_;
     ++totals_.stats;
   }

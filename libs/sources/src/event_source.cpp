@@ -7,6 +7,7 @@
 #include <opencv2/videoio.hpp>
 #include <stdexcept>
 
+#include "evldt/containers/hdf5_events.hpp"
 #include "evldt/containers/packet_source.hpp"
 #include "evldt/events/event_reader.hpp"
 #include <spdlog/spdlog.h>
@@ -57,6 +58,19 @@ class ContainerSource final : public EventSource {
   std::string path_;
   PacketEventReader reader_;
   std::optional<SensorSize> geometry_;
+};
+
+class Hdf5Source final : public EventSource {
+ public:
+  Hdf5Source(const std::filesystem::path& path, const std::string& table) : reader_(path, table) {
+    name_ = path.string() + " (" + reader_.description() + ")";
+  }
+  bool read(EventBatch& batch) override { return reader_.read(batch); }
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return reader_.geometry(); }
+  [[nodiscard]] double progress() const override { return reader_.progress(); }
+
+ private:
+  Hdf5EventReader reader_;
 };
 
 class LcmLogSource final : public EventSource {
@@ -172,6 +186,7 @@ class VideoSource final : public EventSource {
 std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, std::optional<EventFormat> format,
                                             const std::string& channel, Timestamp backwards_slack_us) {
   if (!format && is_lcm_log(path)) return std::make_unique<LcmLogSource>(path, channel, backwards_slack_us);
+  if (!format && is_hdf5(path)) return std::make_unique<Hdf5Source>(path, channel);
   if (!format) {
     if (auto packets = open_packet_container(path, channel)) {
       auto source = std::make_unique<ContainerSource>(std::move(packets), path);

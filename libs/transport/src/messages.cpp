@@ -69,7 +69,7 @@ class WireWalker {
 
 // Encoded sizes of the fixed parts (see the .lcm files).
 constexpr std::size_t kSegmentWireBytes = 8 + 5 * 4 + 1 + 4 + 8 + 8;
-constexpr std::size_t kStatsTailBytes = 8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4;
+constexpr std::size_t kStatsTailBytes = 8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 2 * 8;
 
 template <typename Message>
 WireError check_hash(WireWalker& walker) {

@@ -1,7 +1,8 @@
 #pragma once
 // The evldt-camera service without its command line: reads an event source, validates its events,
 // cuts them into batches by time window and size, and publishes them paced at real time (or a
-// speed factor), optionally looping the source with time continuing forward.
+// speed factor), optionally looping the source with time continuing forward; its statistics go on
+// EVLDT_STATS.
 
 #include <atomic>
 #include <functional>
@@ -26,6 +27,7 @@ struct CameraNodeOptions {
   bool loop = false;
   Timestamp time_slack_us = 1000;
   double progress_period_s = 2;      ///< a progress line this often (0: none)
+  double stats_hz = 1;               ///< statistics on EVLDT_STATS this often, and once at the end (0: none)
 };
 
 struct CameraSummary {
@@ -60,6 +62,9 @@ class CameraNode {
 
  private:
   void publish(const EventBatch& batch, CameraSummary& summary);
+  /// The statistics so far; `rate_events` published since the last ones, over `period_s`.
+  void publish_stats(const CameraSummary& summary, const DecodeCounts& decoded, const DropCounts& drops, double period_s,
+                     std::uint64_t rate_events);
 
   lcm::LCM& lcm_;
   CameraNodeOptions options_;

@@ -1,6 +1,6 @@
 #pragma once
-// Where events come from, behind one interface: a recording file (ECD text, EVT 2.0/3.0, .dat, or
-// an lcm-log of event batches), a built-in simulated scene, or a video file / webcam turned into
+// Where events come from, behind one interface: a recording file (every format of README's table,
+// an lcm-log of event batches among them), a built-in simulated scene, or a video file / webcam turned into
 // events by frame differencing. The offline runner and the camera service read through it.
 
 #include <filesystem>
@@ -35,9 +35,10 @@ class EventSource {
 };
 
 /// A recording. Containers are recognised by their content: an lcm-log (its event batches, checked
-/// as a subscriber checks them, `backwards_slack_us` for their time order), a ROS 2 bag (.db3), an
-/// AEDAT 4.0 file; the other formats by name or `format`. `channel` picks the lcm-log channel or the
-/// bag topic (empty: the first EVENTS_* channel, the first event topic).
+/// as a subscriber checks them, `backwards_slack_us` for their time order), an HDF5 file, a ROS 1 or
+/// 2 bag (.bag, .db3), an MCAP file, an AEDAT 4.0 file; the other formats by their first bytes, name
+/// or `format`. `channel` picks the lcm-log channel, the bag or MCAP topic or the HDF5 event table
+/// (empty: the first EVENTS_* channel, the first event topic, the first known table).
 std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, std::optional<EventFormat> format,
                                             const std::string& channel, Timestamp backwards_slack_us);
 /// A scene run through the event simulator; `label` names it in logs.
