@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -145,10 +146,24 @@ std::optional<SensorSize> sensor_from_attributes(hid_t object) {
   return std::nullopt;
 }
 
-std::uint16_t coordinate(std::int64_t value) { return value >= 0 && value <= 65535 ? static_cast<std::uint16_t>(value) : 65535; }
+// The file's values are untrusted: conversions saturate instead of overflowing, and a coordinate
+// outside 0..65535 (or NaN) becomes 65535, off every sensor, for the validator to drop and count.
+std::uint16_t coordinate(double value) { return value >= 0 && value <= 65535 ? static_cast<std::uint16_t>(std::lround(value)) : 65535; }
+
+Timestamp saturated(double us) {
+  constexpr double kLimit = 9.2e18;  // inside the int64 range
+  if (std::isnan(us)) return 0;
+  return static_cast<Timestamp>(std::clamp(std::round(us), -kLimit, kLimit));
+}
+
+Timestamp saturated_sum(Timestamp a, Timestamp b) {
+  Timestamp sum = 0;
+  if (__builtin_add_overflow(a, b, &sum)) return b > 0 ? std::numeric_limits<Timestamp>::max() : std::numeric_limits<Timestamp>::min();
+  return sum;
+}
 
 /// Integer times are us, floating-point times seconds.
-Timestamp time_us(double seconds) { return static_cast<Timestamp>(std::llround(seconds * 1e6)); }
+Timestamp time_us(double value, bool seconds) { return saturated(seconds ? value * 1e6 : value); }
 
 }  // namespace
 
@@ -196,12 +211,12 @@ struct Hdf5EventReader::Table {
         read_column(3, H5T_NATIVE_INT32, p.data(), count);
         if (float_time) {
           read_column(2, H5T_NATIVE_DOUBLE, values.data(), count);
-          for (std::size_t i = 0; i < count; ++i) t[i] = time_us(values[i]);
+          for (std::size_t i = 0; i < count; ++i) t[i] = time_us(values[i], true);
         } else {
           read_column(2, H5T_NATIVE_INT64, t.data(), count);
         }
         for (std::size_t i = 0; i < count; ++i) {
-          out.push_back(time_offset_us + t[i], coordinate(x[i]), coordinate(y[i]), p[i] > 0 ? std::int8_t{1} : std::int8_t{-1});
+          out.push_back(saturated_sum(time_offset_us, t[i]), coordinate(x[i]), coordinate(y[i]), p[i] > 0 ? std::int8_t{1} : std::int8_t{-1});
         }
         return;
       }
@@ -212,8 +227,7 @@ struct Hdf5EventReader::Table {
                [&](hid_t m, hid_t f) { return H5Dread(columns[0].get(), H5T_NATIVE_DOUBLE, m, f, H5P_DEFAULT, values.data()); });
         for (std::size_t i = 0; i < count; ++i) {
           const double* row = values.data() + 4 * i;
-          out.push_back(float_time ? time_us(row[2]) : static_cast<Timestamp>(row[2]), coordinate(std::llround(row[0])),
-                        coordinate(std::llround(row[1])), row[3] > 0 ? std::int8_t{1} : std::int8_t{-1});
+          out.push_back(time_us(row[2], float_time), coordinate(row[0]), coordinate(row[1]), row[3] > 0 ? std::int8_t{1} : std::int8_t{-1});
         }
         return;
       }
@@ -224,8 +238,8 @@ struct Hdf5EventReader::Table {
                [&](hid_t m, hid_t f) { return H5Dread(columns[0].get(), record_type.get(), m, f, H5P_DEFAULT, records.data()); });
         for (std::size_t i = 0; i < count; ++i) {
           const Record& record = records[i];
-          out.push_back(float_time ? time_us(record.t) : static_cast<Timestamp>(std::llround(record.t)), coordinate(record.x),
-                        coordinate(record.y), record.p > 0 ? std::int8_t{1} : std::int8_t{-1});
+          out.push_back(time_us(record.t, float_time), coordinate(record.x), coordinate(record.y),
+                        record.p > 0 ? std::int8_t{1} : std::int8_t{-1});
         }
         return;
       }

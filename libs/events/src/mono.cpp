@@ -11,12 +11,16 @@ namespace {
 class MonoDecoder final : public EventDecoder {
  public:
   explicit MonoDecoder(std::string source) : source_(std::move(source)) {}
-  void start_packet(std::int64_t time_base_ns) override { base_ns_ = time_base_ns; }
+  // The base splits into us and the ns left over, so that base + time cannot overflow.
+  void start_packet(std::int64_t time_base_ns) override {
+    base_us_ = floor_ns_to_us(time_base_ns);
+    base_ns_left_ = time_base_ns % 1000 + (time_base_ns % 1000 < 0 ? 1000 : 0);
+  }
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
     words_.feed(chunk, [&](const std::uint8_t* word, std::uint64_t) {
       const std::uint32_t high = load_le32(word + 4);
-      out.push_back(floor_ns_to_us(base_ns_ + load_le32(word)), static_cast<std::uint16_t>(high & 0xFFFF),
+      out.push_back(base_us_ + static_cast<Timestamp>((base_ns_left_ + load_le32(word)) / 1000), static_cast<std::uint16_t>(high & 0xFFFF),
                     static_cast<std::uint16_t>((high >> 16) & 0x7FFF), (high >> 31) != 0 ? std::int8_t{1} : std::int8_t{-1});
     });
   }
@@ -28,7 +32,8 @@ class MonoDecoder final : public EventDecoder {
  private:
   std::string source_;
   WordSplitter<8> words_;
-  std::int64_t base_ns_ = 0;
+  Timestamp base_us_ = 0;
+  std::int64_t base_ns_left_ = 0;  // 0..999
 };
 
 }  // namespace
