@@ -1,0 +1,45 @@
+#include <limits>
+#include <stdexcept>
+
+#include "evldt/filters/noise_filters.hpp"
+
+namespace evldt {
+
+// Never within a window of any event time, without overflow when the window is subtracted.
+constexpr Timestamp kNever = std::numeric_limits<Timestamp>::min() / 2;
+
+BackgroundActivityFilter::BackgroundActivityFilter(SensorSize sensor, Timestamp window_us)
+    : EventFilter(sensor),
+      window_us_(window_us),
+      stride_(sensor.width + 2),
+      last_event_(static_cast<std::size_t>(sensor.width + 2) * static_cast<std::size_t>(sensor.height + 2), kNever) {
+  if (window_us <= 0) throw std::invalid_argument("the background-activity window must be positive");
+}
+
+void BackgroundActivityFilter::filter(EventBatch& batch) {
+  const std::ptrdiff_t s = stride_;
+  keep_if(batch, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
+    Timestamp* centre = last_event_.data() + (static_cast<std::ptrdiff_t>(y) + 1) * s + x + 1;
+    const Timestamp since = t - window_us_;
+    const bool correlated = centre[-s - 1] >= since || centre[-s] >= since || centre[-s + 1] >= since || centre[-1] >= since ||
+                            centre[1] >= since || centre[s - 1] >= since || centre[s] >= since || centre[s + 1] >= since;
+    *centre = t;
+    return correlated;
+  });
+}
+
+RefractoryFilter::RefractoryFilter(SensorSize sensor, Timestamp period_us)
+    : EventFilter(sensor), period_us_(period_us), last_passed_(pixels(), kNever) {
+  if (period_us <= 0) throw std::invalid_argument("the refractory period must be positive");
+}
+
+void RefractoryFilter::filter(EventBatch& batch) {
+  keep_if(batch, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
+    Timestamp& last = last_passed_[pixel(x, y)];
+    if (t - last < period_us_) return false;
+    last = t;
+    return true;
+  });
+}
+
+}  // namespace evldt
