@@ -114,8 +114,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   summary.event_seconds = first_t ? static_cast<double>(validator.newest_time() - *first_t) * 1e-6 : 0.0;
   summary.drops = validator.drops();
   summary.decoded = source.decode_counts();
-  summary.counters = pipeline.counters();
-  summary.add_lines(pipeline.lines());
+  summary.add_pipeline(pipeline);
   summary.csv_rows = csv.rows();
   summary.frames = frames.frames();
   summary.print(stdout, options.output.string());

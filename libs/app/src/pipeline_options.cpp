@@ -45,6 +45,24 @@ void PipelineOptions::add_to(CLI::App& app) {
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
   group->add_option("--detect-period-us", detect_period_, "Deterministic mode: detection period in event time")
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
+  auto* filters = app.add_option_group("Noise filters", "Run before storage, in the order given");
+  filters->add_option("--filters", filters_,
+                      "Filters in order, comma-separated: hot-pixel, background-activity, refractory, anti-flicker; or none\n"
+                      "(default: hot-pixel,background-activity)");
+  filters->add_option("--filter-ba-window-us", ba_window_, "background-activity: a neighbour must have fired within this")
+      ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
+  filters->add_option("--filter-refractory-us", filter_refractory_, "refractory: a pixel's events closer than this are dropped")
+      ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
+  filters->add_option("--filter-hot-window-us", hot_window_, "hot-pixel: rates are judged over windows of this event time")
+      ->check(CLI::Range(Timestamp{1000}, Timestamp{60'000'000}));
+  filters->add_option("--filter-hot-rate-hz", hot_rate_, "hot-pixel: a pixel slower than this is never hot")
+      ->check(finite_number() & CLI::PositiveNumber);
+  filters->add_option("--filter-hot-ratio", hot_ratio_, "hot-pixel: hot above this many times its neighbours' mean rate")
+      ->check(finite_number() & CLI::Range(1.0, 1e6));
+  filters->add_option("--filter-flicker-min-hz", flicker_min_hz_, "anti-flicker: lowest flicker frequency")
+      ->check(finite_number() & CLI::Range(17.0, 10000.0));
+  filters->add_option("--filter-flicker-max-hz", flicker_max_hz_, "anti-flicker: highest flicker frequency")
+      ->check(finite_number() & CLI::Range(17.0, 10000.0));
   group->add_option("--time-slack-us", time_slack_us_, "Events older than the newest by more than this are dropped")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{0}, Timestamp{60'000'000}));
@@ -70,6 +88,15 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   }
   if (track_period_) config.schedule.track_period_us = *track_period_;
   if (detect_period_) config.schedule.detect_period_us = *detect_period_;
+  if (filters_) config.filters.chain = parse_filter_chain(*filters_);
+  if (ba_window_) config.filters.background_window_us = *ba_window_;
+  if (filter_refractory_) config.filters.refractory_us = *filter_refractory_;
+  if (hot_window_) config.filters.hot_pixel.window_us = *hot_window_;
+  if (hot_rate_) config.filters.hot_pixel.min_rate_hz = *hot_rate_;
+  if (hot_ratio_) config.filters.hot_pixel.neighbour_ratio = *hot_ratio_;
+  if (flicker_min_hz_) config.filters.anti_flicker.min_hz = *flicker_min_hz_;
+  if (flicker_max_hz_) config.filters.anti_flicker.max_hz = *flicker_max_hz_;
+  check_filter_config(config.filters);
   return config;
 }
 

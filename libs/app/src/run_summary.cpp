@@ -27,7 +27,11 @@ std::string json_escape(const std::string& text) {
 
 }  // namespace
 
-void RunSummary::add_lines(const LineMap& lines) {
+void RunSummary::add_pipeline(const DeterministicPipeline& pipeline) {
+  filters = format_filter_chain(pipeline.config().filters.chain);
+  filtered = pipeline.filter_counts();
+  counters = pipeline.counters();
+  const LineMap& lines = pipeline.lines();
   lines_created = lines.created();
   lines_alive = lines.lines().size();
   for (int r = 0; r < kReleaseReasonCount; ++r) released[r] = lines.released(static_cast<ReleaseReason>(r));
@@ -39,9 +43,17 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
   const double mev = static_cast<double>(counters.events) * 1e-6;
   std::fprintf(out, "evldt summary: %s\n", input.c_str());
   if (!input_error.empty()) std::fprintf(out, "  input error      %s\n", input_error.c_str());
-  std::fprintf(out, "  events           %" PRIu64 " read, %" PRIu64 " processed, %" PRIu64 " dropped (%" PRIu64
+  std::fprintf(out, "  events           %" PRIu64 " read, %" PRIu64 " stored, %" PRIu64 " dropped as invalid (%" PRIu64
                " off-sensor, %" PRIu64 " time-backwards), %" PRIu64 " clock resets\n",
                events_read, counters.events, drops.total(), drops.off_sensor, drops.time_backwards, drops.clock_resets);
+  if (filters == "none") {
+    std::fprintf(out, "  filters          none\n");
+  } else {
+    std::fprintf(out, "  filters          %s: %" PRIu64 " in, %" PRIu64 " passed; dropped %" PRIu64 " hot-pixel, %" PRIu64
+                 " background-activity, %" PRIu64 " refractory, %" PRIu64 " anti-flicker\n",
+                 filters.c_str(), filtered.events_in, filtered.passed, filtered.hot_pixel, filtered.background_activity,
+                 filtered.refractory, filtered.anti_flicker);
+  }
   if (decoded.skipped_words > 0 || decoded.trigger_events > 0) {
     std::fprintf(out, "  decoding         %" PRIu64 " words of reserved or unknown types skipped, %" PRIu64 " trigger events\n",
                  decoded.skipped_words, decoded.trigger_events);
@@ -69,9 +81,13 @@ void RunSummary::write_json(const std::filesystem::path& path) const {
   if (!out) throw std::runtime_error("cannot create " + path.string());
   out << "{\n  \"input\": \"" << json_escape(input) << "\",\n";
   out << "  \"input_error\": \"" << json_escape(input_error) << "\",\n";
-  out << "  \"events_read\": " << events_read << ",\n  \"events_processed\": " << counters.events << ",\n";
+  out << "  \"events_read\": " << events_read << ",\n  \"events_stored\": " << counters.events << ",\n";
   out << "  \"dropped_off_sensor\": " << drops.off_sensor << ",\n  \"dropped_time_backwards\": " << drops.time_backwards << ",\n";
   out << "  \"clock_resets\": " << drops.clock_resets << ",\n";
+  out << "  \"filters\": \"" << filters << "\",\n  \"filtered\": {\"events_in\": " << filtered.events_in
+      << ", \"passed\": " << filtered.passed << ", \"hot_pixel\": " << filtered.hot_pixel
+      << ", \"background_activity\": " << filtered.background_activity << ", \"refractory\": " << filtered.refractory
+      << ", \"anti_flicker\": " << filtered.anti_flicker << "},\n";
   out << "  \"skipped_words\": " << decoded.skipped_words << ",\n  \"trigger_events\": " << decoded.trigger_events << ",\n";
   out << "  \"event_seconds\": " << event_seconds << ",\n  \"wall_seconds\": " << wall_seconds << ",\n";
   out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds << ",\n";

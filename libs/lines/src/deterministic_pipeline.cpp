@@ -8,6 +8,7 @@ namespace evldt {
 
 DeterministicPipeline::DeterministicPipeline(const PipelineConfig& config, bool keep_surface)
     : config_(config),
+      filters_(config.filters, config.lattice.sensor),
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha, keep_surface),
       lines_(lattice_.geometry()),
       detector_(lattice_.geometry(), config.score),
@@ -48,6 +49,13 @@ void DeterministicPipeline::update_next_due() {
 }
 
 void DeterministicPipeline::process(const EventBatch& batch) {
+  if (filters_.empty()) return store(batch);
+  filtered_ = batch;  // vector assignment reuses the capacity: no allocation once warm
+  filters_.filter(filtered_);
+  store(filtered_);
+}
+
+void DeterministicPipeline::store(const EventBatch& batch) {
   const std::size_t n = batch.size();
   if (n == 0) return;
   if (!started_) {

@@ -13,6 +13,7 @@ constexpr std::size_t kInsertChunk = 8192;
 
 RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
     : config_(config),
+      filters_(config.filters, config.lattice.sensor),
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
       detect_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
       track_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
@@ -48,7 +49,15 @@ void RealtimeEngine::stop() {
   if (track_thread_.joinable()) track_thread_.join();
 }
 
-void RealtimeEngine::process(const EventBatch& batch) {
+void RealtimeEngine::process(const EventBatch& input) {
+  const EventBatch* stored = &input;
+  if (!filters_.empty()) {
+    std::lock_guard lock(filter_mutex_);
+    filtered_ = input;  // vector assignment reuses the capacity: no allocation once warm
+    filters_.filter(filtered_);
+    stored = &filtered_;
+  }
+  const EventBatch& batch = *stored;
   const std::size_t n = batch.size();
   for (std::size_t begin = 0; begin < n; begin += kInsertChunk) {
     const std::size_t end = std::min(n, begin + kInsertChunk);
@@ -107,8 +116,18 @@ Timestamp RealtimeEngine::snapshot(std::vector<TrackedLine>& out) const {
   return lines_time_us_;
 }
 
+std::vector<std::uint32_t> RealtimeEngine::masked_pixels() const {
+  std::lock_guard lock(filter_mutex_);
+  const auto masked = filters_.masked_pixels();
+  return {masked.begin(), masked.end()};
+}
+
 EngineCounters RealtimeEngine::counters() const {
   EngineCounters c;
+  {
+    std::lock_guard lock(filter_mutex_);
+    c.filtered = filters_.counts();
+  }
   {
     std::lock_guard lock(lattice_mutex_);
     c.events = events_stored_;

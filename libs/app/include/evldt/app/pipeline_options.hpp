@@ -29,6 +29,9 @@ class PipelineOptions {
   std::optional<float> fit_threshold_, inlier_ratio_, perturbation_;
   std::optional<std::string> multi_block_norm_;
   std::optional<Timestamp> track_period_, detect_period_;
+  std::optional<std::string> filters_;
+  std::optional<Timestamp> ba_window_, filter_refractory_, hot_window_;
+  std::optional<double> hot_rate_, hot_ratio_, flicker_min_hz_, flicker_max_hz_;
   Timestamp time_slack_us_ = 1000;
 };
 

@@ -17,6 +17,8 @@ struct RunSummary {
   std::uint64_t events_read = 0;
   DecodeCounts decoded;  ///< words the recording's decoder skipped, trigger events it counted
   DropCounts drops;
+  std::string filters;     ///< the chain, "none" for no filter
+  FilterCounts filtered;
   double event_seconds = 0;
   double wall_seconds = 0;
   PipelineCounters counters;
@@ -27,8 +29,9 @@ struct RunSummary {
   std::uint64_t csv_rows = 0;
   int frames = 0;
 
-  /// Takes line counts and lifetimes (released plus still alive) from the line map.
-  void add_lines(const LineMap& lines);
+  /// Takes the filter chain, its counts, the round counters, line counts and lifetimes (released
+  /// plus still alive) from the pipeline.
+  void add_pipeline(const DeterministicPipeline& pipeline);
   void print(std::FILE* out, const std::string& csv_path) const;
   void write_json(const std::filesystem::path& path) const;
 };

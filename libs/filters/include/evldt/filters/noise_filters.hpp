@@ -1,7 +1,7 @@
 #pragma once
 // The noise filters (DESIGN 8: noise before storage):
-//   background-activity: the spatio-temporal correlation filter; an event passes when one of its 8
-//     neighbours fired within a time window (isolated thermal / leak events do not have one);
+//   background-activity: the spatio-temporal correlation filter; an event passes when its pixel or
+//     one of its 8 neighbours fired within a time window (isolated thermal / leak events did not);
 //   refractory: a pixel's events closer than a period to its previous passed one are dropped;
 //   hot-pixel: learns pixels that fire far above their neighbourhood and masks them, releasing a
 //     pixel that cools;
@@ -45,6 +45,9 @@ struct HotPixelParams {
   double neighbour_ratio = 8;     ///< hot: above this many times the mean rate of its 8 neighbours (+1 event)
 };
 
+/// Throws std::invalid_argument, with the reason, for parameters a filter cannot run with.
+void check_params(const HotPixelParams& params);
+
 class HotPixelFilter final : public EventFilter {
  public:
   HotPixelFilter(SensorSize sensor, const HotPixelParams& params);
@@ -75,6 +78,8 @@ struct AntiFlickerParams {
   double tolerance = 0.1;        ///< of a period, for a burst to fall on the predicted phase
   Timestamp burst_gap_us = 1000; ///< events of one polarity closer than this at a pixel are one burst
 };
+
+void check_params(const AntiFlickerParams& params);
 
 class AntiFlickerFilter final : public EventFilter {
  public:

@@ -1,6 +1,7 @@
 #pragma once
-// The deterministic pipeline (DESIGN 6): storage of every event, tracking every track_period_us and
-// detection every detect_period_us of EVENT time, so a run's output depends only on its input.
+// The deterministic pipeline (DESIGN 6): the noise filters, storage of every event that passes them,
+// tracking every track_period_us and detection every detect_period_us of EVENT time, so a run's
+// output depends only on its input.
 
 #include <cstdint>
 #include <functional>
@@ -33,24 +34,30 @@ class DeterministicPipeline {
   /// disables it): the steps fall on the same clock grid as ground truth sampled every period_us.
   void set_output(Timestamp period_us, StepCallback on_step);
 
-  /// Feeds on-sensor events in time order (an EventValidator upstream guarantees both). A round due
-  /// at time T sees exactly the events with t < T. After a clock reset upstream, the schedule
-  /// begins again at the first batch more than kClockStepBackUs behind it.
+  /// Feeds on-sensor events in time order (an EventValidator upstream guarantees both) through the
+  /// filters into storage. A round due at time T sees exactly the stored events with t < T. After a
+  /// clock reset upstream, the schedule begins again at the first batch more than kClockStepBackUs
+  /// behind it.
   void process(const EventBatch& batch);
 
   [[nodiscard]] const LineMap& lines() const { return lines_; }
   [[nodiscard]] LineMap& lines() { return lines_; }
   [[nodiscard]] const ScarfLattice& lattice() const { return lattice_; }
   [[nodiscard]] const PipelineCounters& counters() const { return counters_; }
+  [[nodiscard]] FilterCounts filter_counts() const { return filters_.counts(); }
+  [[nodiscard]] const FilterChain& filters() const { return filters_; }
   [[nodiscard]] const PipelineConfig& config() const { return config_; }
 
  private:
+  void store(const EventBatch& batch);
   void start(Timestamp t0);
   void run_rounds_until(Timestamp t);  // every round due at a time <= t
   void skip_gap(Timestamp t);
   void update_next_due();
 
   PipelineConfig config_;
+  FilterChain filters_;
+  EventBatch filtered_;  // what passed the filters, reused
   ScarfLattice lattice_;
   LineMap lines_;
   LineDetector detector_;

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "evldt/events/event.hpp"
+#include "evldt/filters/filter_chain.hpp"
 
 namespace evldt {
 
@@ -39,6 +40,7 @@ struct ScheduleParams {
 };
 
 struct PipelineConfig {
+  FilterConfig filters;  ///< noise filters run before storage
   LatticeParams lattice;
   ScoreParams score;
   TrackParams track;

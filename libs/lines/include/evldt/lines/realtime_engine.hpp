@@ -1,5 +1,5 @@
 #pragma once
-// The real-time engine (DESIGN 6): the caller's thread stores events as they arrive while detection
+// The real-time engine (DESIGN 6): the caller's thread filters and stores events as they arrive while detection
 // and tracking loop on their own threads, each starting a round once a period of event time has
 // been stored since its last (or a period of wall time has passed with anything new). Each loop
 // works on its own copy of the lattice, updated under a short lock, so storage never waits for a
@@ -17,7 +17,8 @@
 namespace evldt {
 
 struct EngineCounters {
-  std::uint64_t events = 0;
+  FilterCounts filtered;    ///< what the noise filters let through and dropped
+  std::uint64_t events = 0;  ///< stored
   std::uint64_t detect_rounds = 0;
   std::uint64_t track_rounds = 0;
   std::uint64_t lines_created = 0;
@@ -34,13 +35,15 @@ class RealtimeEngine {
   void start();
   void stop();  ///< joins the loops; idempotent
 
-  /// Stores on-sensor, time-ordered events (from one producer thread).
+  /// Filters and stores on-sensor, time-ordered events (from one producer thread).
   void process(const EventBatch& batch);
 
   /// Copies the live lines into `out` (reusing its capacity) and returns the event time of the lattice
   /// state they were last tracked or detected on.
   Timestamp snapshot(std::vector<TrackedLine>& out) const;
   [[nodiscard]] EngineCounters counters() const;
+  /// The pixels the hot-pixel filter masks now (y * width + x).
+  [[nodiscard]] std::vector<std::uint32_t> masked_pixels() const;
   [[nodiscard]] const LatticeGeometry& geometry() const { return lattice_.geometry(); }
   /// Folds a per-start epoch into line ids so a restarted process never repeats one.
   void set_first_line_id(std::uint64_t first);
@@ -51,6 +54,9 @@ class RealtimeEngine {
             Round round);
 
   PipelineConfig config_;
+  mutable std::mutex filter_mutex_;           // the producer filters under it; counters() reads under it
+  FilterChain filters_;                       // guarded by filter_mutex_
+  EventBatch filtered_;                       // the producer's, reused
   ScarfLattice lattice_;                      // guarded by lattice_mutex_
   ScarfLattice detect_view_, track_view_;     // each owned by its loop thread
   mutable std::mutex lattice_mutex_;
