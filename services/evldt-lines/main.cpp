@@ -46,17 +46,21 @@ int main(int argc, char** argv) {
     std::printf(
         "evldt-lines summary\n"
         "  batches   %llu received, %llu lost (sequence gaps), %llu late (%llu resyncs), %llu invalid messages, %llu camera restarts\n"
-        "  events    %llu stored, %llu dropped (%llu off sensor, %llu back in time), %llu clock resets\n"
+        "  events    %llu received, %llu stored, %llu dropped as invalid (%llu off sensor, %llu back in time), %llu clock resets\n"
+        "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
         "  loops     %llu detection rounds, %llu tracking rounds\n"
         "  output    %llu lines created, %llu segment lists published\n"
         "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches)\n",
         static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),
         static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.sequence.resyncs),
         static_cast<unsigned long long>(t.receiver.invalid_messages),
-        static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.events_stored),
+        static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.events_received),
+        static_cast<unsigned long long>(t.events_stored),
         static_cast<unsigned long long>(t.receiver.drops.total()), static_cast<unsigned long long>(t.receiver.drops.off_sensor),
         static_cast<unsigned long long>(t.receiver.drops.time_backwards),
-        static_cast<unsigned long long>(t.receiver.drops.clock_resets), static_cast<unsigned long long>(t.detect_rounds),
+        static_cast<unsigned long long>(t.receiver.drops.clock_resets), static_cast<unsigned long long>(t.filtered.hot_pixel),
+        static_cast<unsigned long long>(t.filtered.background_activity), static_cast<unsigned long long>(t.filtered.refractory),
+        static_cast<unsigned long long>(t.filtered.anti_flicker), static_cast<unsigned long long>(t.detect_rounds),
         static_cast<unsigned long long>(t.track_rounds), static_cast<unsigned long long>(t.lines_created),
         static_cast<unsigned long long>(t.lists_published), t.latency.median_ms, t.latency.p99_ms, t.latency.samples);
     return 0;

@@ -139,7 +139,9 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
   EXPECT_EQ(totals.receiver.sequence.received, sent.batches);
   EXPECT_EQ(totals.receiver.sequence.lost, 0u);
   EXPECT_EQ(totals.receiver.invalid_messages, 0u);
-  EXPECT_EQ(totals.events_stored, sent.events_published);
+  EXPECT_EQ(totals.events_received, sent.events_published);
+  EXPECT_EQ(totals.filtered.events_in, sent.events_published);
+  EXPECT_EQ(totals.events_stored, totals.filtered.passed);
   EXPECT_GT(totals.track_rounds, 0u);
   EXPECT_EQ(collector.invalid(), 0);
 
@@ -249,7 +251,7 @@ TEST(Nodes, GarbageAndForeignMessagesAreCountedNotFatal) {
   ASSERT_TRUE(wait_for([&] { return lines.node.totals().receiver.invalid_messages == 5; }));
   lines.stop();
   const LinesNodeTotals totals = lines.node.totals();
-  EXPECT_EQ(totals.events_stored, 1u);
+  EXPECT_EQ(totals.events_received, 1u);
   EXPECT_EQ(totals.receiver.drops.off_sensor, 1u);
   EXPECT_EQ(totals.receiver.sequence.received, 1u);
 }
@@ -279,7 +281,8 @@ TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   EXPECT_EQ(totals.receiver.sequence.restarts, 1u);
   EXPECT_EQ(totals.receiver.sequence.lost, 0u);
   EXPECT_EQ(totals.receiver.drops.total(), 0u);  // the restarted clock is not "time backwards"
-  EXPECT_EQ(totals.events_stored, first.events_published + second.events_published);
+  EXPECT_EQ(totals.events_received, first.events_published + second.events_published);
+  EXPECT_EQ(totals.events_stored, totals.filtered.passed);
 
   // Ids of the first camera run and of the second never overlap.
   const auto lists = collector.lists();

@@ -94,6 +94,10 @@ stats_t make_stats() {
   msg.service = "evldt-lines";
   msg.source = "cam0";
   msg.events_in = 99;
+  msg.filters = "hot-pixel,background-activity";
+  msg.filtered_hot_pixel = 7;
+  msg.masked_pixels = {5, 640 * 3 + 9};
+  msg.num_masked_pixels = 2;
   return msg;
 }
 
@@ -153,6 +157,9 @@ TEST(Messages, StatsRoundTrip) {
   ASSERT_EQ(decode_message(encode(make_stats()), decoded), WireError::None);
   EXPECT_EQ(decoded.events_in, 99);
   EXPECT_EQ(decoded.service, "evldt-lines");
+  EXPECT_EQ(decoded.filters, "hot-pixel,background-activity");
+  EXPECT_EQ(decoded.filtered_hot_pixel, 7);
+  EXPECT_EQ(decoded.masked_pixels, (std::vector<std::int32_t>{5, 640 * 3 + 9}));
 }
 
 // Every strict prefix of a valid message, and the message with a byte appended, must be refused.

@@ -49,21 +49,28 @@ void DeterministicPipeline::update_next_due() {
 }
 
 void DeterministicPipeline::process(const EventBatch& batch) {
-  if (filters_.empty()) return store(batch);
-  filtered_ = batch;  // vector assignment reuses the capacity: no allocation once warm
-  filters_.filter(filtered_);
-  store(filtered_);
-}
-
-void DeterministicPipeline::store(const EventBatch& batch) {
-  const std::size_t n = batch.size();
-  if (n == 0) return;
+  if (batch.empty()) return;
+  // The schedule follows the input's clock: events the filters drop still move event time on.
   if (!started_) {
     start(batch.t[0]);
   } else if (batch.t[0] < next_due_ - kClockStepBackUs) {
     ++counters_.clock_restarts;
     start(batch.t[0]);
   }
+  if (filters_.empty()) {
+    store(batch);
+  } else {
+    filtered_ = batch;  // vector assignment reuses the capacity: no allocation once warm
+    filters_.filter(filtered_);
+    store(filtered_);
+  }
+  // Rounds due up to the batch's last event: every stored event is older than them (store() ran
+  // each round due at or before a stored event's time before storing it).
+  if (batch.t.back() >= next_due_) run_rounds_until(batch.t.back());
+}
+
+void DeterministicPipeline::store(const EventBatch& batch) {
+  const std::size_t n = batch.size();
   const Timestamp* ts = batch.t.data();
   const std::uint16_t* xs = batch.x.data();
   const std::uint16_t* ys = batch.y.data();

@@ -50,6 +50,7 @@ void RealtimeEngine::stop() {
 }
 
 void RealtimeEngine::process(const EventBatch& input) {
+  if (input.empty()) return;
   const EventBatch* stored = &input;
   if (!filters_.empty()) {
     std::lock_guard lock(filter_mutex_);
@@ -61,16 +62,32 @@ void RealtimeEngine::process(const EventBatch& input) {
   const std::size_t n = batch.size();
   for (std::size_t begin = 0; begin < n; begin += kInsertChunk) {
     const std::size_t end = std::min(n, begin + kInsertChunk);
+    const bool last = end == n;
     bool wake = false;
     {
       std::lock_guard lock(lattice_mutex_);
       lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin));
       events_stored_ += end - begin;
       latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
+      if (last) note_input(input);
       wake = latest_event_us_ >= std::min(detect_wake_at_us_, track_wake_at_us_);
     }
     if (wake) lattice_changed_.notify_all();
   }
+  if (n > 0) return;
+  bool wake = false;
+  {
+    std::lock_guard lock(lattice_mutex_);
+    note_input(input);
+    wake = latest_event_us_ >= std::min(detect_wake_at_us_, track_wake_at_us_);
+  }
+  if (wake) lattice_changed_.notify_all();
+}
+
+void RealtimeEngine::note_input(const EventBatch& input) {
+  // Events the filters dropped still move event time on, so rounds come due as they would without them.
+  events_received_ += input.size();
+  latest_event_us_ = std::max(latest_event_us_, input.t.back());
 }
 
 template <typename Round>
@@ -83,21 +100,21 @@ void RealtimeEngine::loop(ScarfLattice& view, Timestamp& wake_at_us, std::atomic
     Timestamp now = 0;
     {
       std::unique_lock lock(lattice_mutex_);
-      // A round is due once a period of event time has been stored since the last one (the
+      // A round is due once a period of event time has come in since the last one (the
       // deterministic schedule; more rounds would repeat work the storage thread needs the CPU
-      // for). A round on an unchanged lattice would repeat the last one.
-      const auto due = [&] { return stopping_ || (events_stored_ != seen && latest_event_us_ >= next_due); };
+      // for). Without new input, a round would repeat the last one.
+      const auto due = [&] { return stopping_ || (events_received_ != seen && latest_event_us_ >= next_due); };
       wake_at_us = next_due;
       if (!lattice_changed_.wait_for(lock, wall_period, due)) {
         // A period of wall time without a period of event time (a sparse or ending stream): run
         // on whatever is new, so the last events are never left waiting.
         wake_at_us = std::numeric_limits<Timestamp>::min();
-        lattice_changed_.wait(lock, [&] { return stopping_ || events_stored_ != seen; });
+        lattice_changed_.wait(lock, [&] { return stopping_ || events_received_ != seen; });
       }
       wake_at_us = std::numeric_limits<Timestamp>::max();  // busy with a round: nothing to wake
       if (stopping_) return;
       view.copy_state_from(lattice_);
-      seen = events_stored_;
+      seen = events_received_;
       now = latest_event_us_;
     }
     next_due = now + period_us;
@@ -131,6 +148,7 @@ EngineCounters RealtimeEngine::counters() const {
   {
     std::lock_guard lock(lattice_mutex_);
     c.events = events_stored_;
+    c.events_received = events_received_;
     c.latest_event_us = latest_event_us_;
   }
   {

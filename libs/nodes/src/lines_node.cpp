@@ -1,5 +1,6 @@
 #include "evldt/nodes/lines_node.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
@@ -7,6 +8,10 @@
 #include "evldt/transport/channels.hpp"
 
 namespace evldt {
+namespace {
+// A statistics message lists at most this many masked pixels (16 KiB), whatever a broken sensor does.
+constexpr std::size_t kMaxListedMaskedPixels = 4096;
+}  // namespace
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -83,6 +88,8 @@ void LinesNode::start_engine() {
   latency_ = LatencyTracker();
   next_line_id_ += retired.lines_created;
   retired_.events += retired.events;
+  retired_.events_received += retired.events_received;
+  retired_.filtered += retired.filtered;
   retired_.detect_rounds += retired.detect_rounds;
   retired_.track_rounds += retired.track_rounds;
   retired_.lines_created += retired.lines_created;
@@ -181,6 +188,18 @@ void LinesNode::publish_stats(double period_s) {
   msg.latency_samples = static_cast<std::int32_t>(latency.samples);
   msg.latency_median_ms = static_cast<float>(latency.median_ms);
   msg.latency_p99_ms = static_cast<float>(latency.p99_ms);
+  msg.filtered_hot_pixel = static_cast<std::int64_t>(now.filtered.hot_pixel);
+  msg.filtered_background_activity = static_cast<std::int64_t>(now.filtered.background_activity);
+  msg.filtered_refractory = static_cast<std::int64_t>(now.filtered.refractory);
+  msg.filtered_anti_flicker = static_cast<std::int64_t>(now.filtered.anti_flicker);
+  msg.filters = "none";
+  if (const auto engine = this->engine()) {
+    msg.filters = format_filter_chain(engine->config().filters.chain);
+    std::vector<std::uint32_t> masked = engine->masked_pixels();
+    masked.resize(std::min<std::size_t>(masked.size(), kMaxListedMaskedPixels));
+    msg.masked_pixels.assign(masked.begin(), masked.end());
+  }
+  msg.num_masked_pixels = static_cast<std::int32_t>(msg.masked_pixels.size());
   lcm_.publish(std::string(kStatsChannel), &msg);
   last_stats_ = now;
   last_latency_ = latency;
@@ -195,6 +214,8 @@ LinesNodeTotals LinesNode::totals() const {
     totals.receiver = receiver_counts_;
     totals.engine_restarts = engine_restarts_;
     totals.events_stored = retired_.events;
+    totals.events_received = retired_.events_received;
+    totals.filtered = retired_.filtered;
     totals.detect_rounds = retired_.detect_rounds;
     totals.track_rounds = retired_.track_rounds;
     totals.lines_created = retired_.lines_created;
@@ -203,6 +224,8 @@ LinesNodeTotals LinesNode::totals() const {
   if (engine) {
     const EngineCounters counters = engine->counters();
     totals.events_stored += counters.events;
+    totals.events_received += counters.events_received;
+    totals.filtered += counters.filtered;
     totals.detect_rounds += counters.detect_rounds;
     totals.track_rounds += counters.track_rounds;
     totals.lines_created += counters.lines_created;

@@ -83,9 +83,11 @@ void VizNode::render(cv::Mat& canvas) {
                        event_rate_ * 1e-6, lines_.size()),
            0);
   if (stats_) {
+    draw_masked_pixels(sensor, stats_->masked_pixels, options_.render.scale, canvas);
     put_line(canvas,
-             fmt::format("detect {:.0f} Hz  track {:.0f} Hz  latency {:.1f}/{:.1f} ms  lost {}", stats_->detect_hz,
-                         stats_->track_hz, stats_->latency_median_ms, stats_->latency_p99_ms, stats_->batches_lost),
+             fmt::format("detect {:.0f} Hz  track {:.0f} Hz  latency {:.1f}/{:.1f} ms  lost {}  hot pixels {}", stats_->detect_hz,
+                         stats_->track_hz, stats_->latency_median_ms, stats_->latency_p99_ms, stats_->batches_lost,
+                         stats_->num_masked_pixels),
              1);
   } else {
     put_line(canvas, "no statistics from evldt-lines yet", 1);

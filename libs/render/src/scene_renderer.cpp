@@ -50,4 +50,14 @@ void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std
   }
 }
 
+void draw_masked_pixels(SensorSize sensor, std::span<const std::int32_t> pixels, int scale, cv::Mat& canvas) {
+  scale = std::max(1, scale);
+  const std::int64_t count = static_cast<std::int64_t>(sensor.width) * sensor.height;
+  for (const std::int32_t pixel : pixels) {
+    if (pixel < 0 || pixel >= count) continue;
+    const cv::Point centre((pixel % sensor.width) * scale + scale / 2, (pixel / sensor.width) * scale + scale / 2);
+    cv::circle(canvas, centre, 2 + 2 * scale, cv::Scalar(255, 0, 255), 1, cv::LINE_AA);
+  }
+}
+
 }  // namespace evldt

@@ -69,7 +69,7 @@ class WireWalker {
 
 // Encoded sizes of the fixed parts (see the .lcm files).
 constexpr std::size_t kSegmentWireBytes = 8 + 5 * 4 + 1 + 4 + 8 + 8;
-constexpr std::size_t kStatsTailBytes = 8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 2 * 8;
+constexpr std::size_t kStatsMiddleBytes = 8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 2 * 8;  // period_s .. trigger_events
 
 template <typename Message>
 WireError check_hash(WireWalker& walker) {
@@ -113,7 +113,8 @@ WireError decode_message(std::span<const std::uint8_t> bytes, stats_t& out) {
   WireWalker walker(bytes);
   if (const auto hash = check_hash<stats_t>(walker); hash != WireError::None) return hash;
   const bool well_formed =
-      walker.skip(2 * 8) && walker.skip_string() && walker.skip_string() && walker.remaining() == kStatsTailBytes;
+      walker.skip(2 * 8) && walker.skip_string() && walker.skip_string() && walker.skip(kStatsMiddleBytes) && walker.skip_string() &&
+      walker.skip(4 * 8) && walker.counted_tail(4);
   return decode_checked(bytes, out, well_formed);
 }
 

@@ -40,6 +40,15 @@ struct FilterCounts {
   std::uint64_t refractory = 0;
   std::uint64_t anti_flicker = 0;
   [[nodiscard]] std::uint64_t dropped() const { return hot_pixel + background_activity + refractory + anti_flicker; }
+  FilterCounts& operator+=(const FilterCounts& other) {
+    events_in += other.events_in;
+    passed += other.passed;
+    hot_pixel += other.hot_pixel;
+    background_activity += other.background_activity;
+    refractory += other.refractory;
+    anti_flicker += other.anti_flicker;
+    return *this;
+  }
 };
 
 class FilterChain {

@@ -17,8 +17,9 @@
 namespace evldt {
 
 struct EngineCounters {
-  FilterCounts filtered;    ///< what the noise filters let through and dropped
-  std::uint64_t events = 0;  ///< stored
+  FilterCounts filtered;             ///< what the noise filters let through and dropped
+  std::uint64_t events_received = 0;  ///< handed to process()
+  std::uint64_t events = 0;           ///< stored
   std::uint64_t detect_rounds = 0;
   std::uint64_t track_rounds = 0;
   std::uint64_t lines_created = 0;
@@ -45,10 +46,12 @@ class RealtimeEngine {
   /// The pixels the hot-pixel filter masks now (y * width + x).
   [[nodiscard]] std::vector<std::uint32_t> masked_pixels() const;
   [[nodiscard]] const LatticeGeometry& geometry() const { return lattice_.geometry(); }
+  [[nodiscard]] const PipelineConfig& config() const { return config_; }
   /// Folds a per-start epoch into line ids so a restarted process never repeats one.
   void set_first_line_id(std::uint64_t first);
 
  private:
+  void note_input(const EventBatch& input);  // under lattice_mutex_
   template <typename Round>
   void loop(ScarfLattice& view, Timestamp& wake_at_us, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
             Round round);
@@ -62,6 +65,7 @@ class RealtimeEngine {
   mutable std::mutex lattice_mutex_;
   std::condition_variable lattice_changed_;
   std::uint64_t events_stored_ = 0;           // guarded by lattice_mutex_
+  std::uint64_t events_received_ = 0;         // stored or filtered; guarded by lattice_mutex_
   Timestamp latest_event_us_ = 0;             // guarded by lattice_mutex_
   bool stopping_ = false;                     // guarded by lattice_mutex_
   // Event time at which each loop, while it waits, wants to be woken (guarded by lattice_mutex_):

@@ -31,6 +31,8 @@ struct LinesNodeOptions {
 /// Totals since start (what the stats message and the exit summary report).
 struct LinesNodeTotals {
   ReceiverCounts receiver;
+  std::uint64_t events_received = 0;  ///< valid events handed to the engine
+  FilterCounts filtered;              ///< what the noise filters dropped of them
   std::uint64_t events_stored = 0;
   std::uint64_t detect_rounds = 0;
   std::uint64_t track_rounds = 0;
