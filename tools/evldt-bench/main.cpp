@@ -63,7 +63,9 @@ struct Figures {
   double lines_tracked = 0;
   Timing snapshot;              ///< per full lattice copy (the real-time loops' consistent view)
   Timing snapshot_1ms;          ///< per update of a view after 1 ms of the scene's events
+  Timing filters;               ///< per event, the default noise filters from an empty state
   Timing pipeline;              ///< per event, the whole deterministic pipeline from an empty state
+  Timing pipeline_unfiltered;   ///< the same without the noise filters
   double lattice_mb = 0;        ///< one lattice's storage
   double events_mb = 0;         ///< the simulated events (part of the RSS, not of evldt's state)
   double peak_rss_mb = 0;
@@ -228,11 +230,25 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
 
   BenchSettings once = settings;
   once.min_time_s = 0;  // a pass over the whole window is long enough
+  EventBatch filtered;
+  f.filters = per_item(time_op(once, [&] {
+                         FilterChain chain(config.filters, config.lattice.sensor);
+                         filtered = events;
+                         chain.filter(filtered);
+                       }),
+                       n);
   f.pipeline = per_item(time_op(once, [&] {
                           DeterministicPipeline pipeline(config);
                           pipeline.process(events);
                         }),
                         n);
+  PipelineConfig unfiltered = config;
+  unfiltered.filters.chain.clear();
+  f.pipeline_unfiltered = per_item(time_op(once, [&] {
+                                     DeterministicPipeline pipeline(unfiltered);
+                                     pipeline.process(events);
+                                   }),
+                                   n);
   f.peak_rss_mb = peak_rss_mb();
   return f;
 }
@@ -267,21 +283,21 @@ std::optional<Figures> measure_in_child(const SizeCase& size_case, const BenchSe
 }
 
 void print_header() {
-  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %8s %8s %10s %9s %8s\n", "size", "scene", "Mev/s*", "storage",
-              "(AoS)", "receive", "detect", "ns/point", "track", "ns/line", "copy", "1ms-upd", "pipeline", "lattice", "RSS");
-  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %8s %8s %10s %9s %8s\n", "", "", "scene", "Mev/s", "Mev/s", "Mev/s", "Hz",
-              "(points)", "Hz", "(lines)", "us", "us", "Mev/s", "MB", "MB");
+  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %8s %8s %8s %10s %9s %9s %8s\n", "size", "scene", "Mev/s*", "storage",
+              "(AoS)", "receive", "detect", "ns/point", "track", "ns/line", "copy", "1ms-upd", "filters", "pipeline", "(no filt)",
+              "lattice", "RSS");
+  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %8s %8s %8s %10s %9s %9s %8s\n", "", "", "scene", "Mev/s", "Mev/s", "Mev/s",
+              "Hz", "(points)", "Hz", "(lines)", "us", "us", "Mev/s", "Mev/s", "Mev/s", "MB", "MB");
 }
 
 void print_row(const SizeCase& c, const Figures& f) {
   char points[32], lines[32];
   std::snprintf(points, sizeof points, "%.1f (%.0f)", f.detect.median * 1e9 / std::max(f.active_points, 1.0), f.active_points);
   std::snprintf(lines, sizeof lines, "%.0f (%.0f)", f.track.median * 1e9 / std::max(f.lines_tracked, 1.0), f.lines_tracked);
-  std::printf("%-9s %-17s %7.2f %9.1f %9.1f %9.1f %10.0f %11s %10.0f %12s %8.1f %8.1f %10.2f %9.2f %8.0f\n", c.label, c.scene,
-              f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median, 1e-6 / f.receive.median,
-              1.0 / f.detect.median, points,
-              1.0 / f.track.median, lines, f.snapshot.median * 1e6, f.snapshot_1ms.median * 1e6, 1e-6 / f.pipeline.median,
-              f.lattice_mb, f.peak_rss_mb);
+  std::printf("%-9s %-17s %7.2f %9.1f %9.1f %9.1f %10.0f %11s %10.0f %12s %8.1f %8.1f %8.1f %10.2f %9.2f %9.2f %8.0f\n", c.label,
+              c.scene, f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median, 1e-6 / f.receive.median,
+              1.0 / f.detect.median, points, 1.0 / f.track.median, lines, f.snapshot.median * 1e6, f.snapshot_1ms.median * 1e6,
+              1e-6 / f.filters.median, 1e-6 / f.pipeline.median, 1e-6 / f.pipeline_unfiltered.median, f.lattice_mb, f.peak_rss_mb);
   std::fflush(stdout);
 }
 
@@ -307,7 +323,9 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
     write_timing(out, "track_pass_us", f.track, "us", 1e6);
     write_timing(out, "snapshot_us", f.snapshot, "us", 1e6);
     write_timing(out, "snapshot_after_1ms_us", f.snapshot_1ms, "us", 1e6);
+    write_timing(out, "filters_ns_per_event", f.filters, "ns", 1e9);
     write_timing(out, "pipeline_ns_per_event", f.pipeline, "ns", 1e9);
+    write_timing(out, "pipeline_unfiltered_ns_per_event", f.pipeline_unfiltered, "ns", 1e9);
     out << "      \"storage_mev_s\": " << 1e-6 / f.storage.median << ",\n"
         << "      \"receive_mev_s\": " << 1e-6 / f.receive.median << ",\n"
         << "      \"detect_hz\": " << 1.0 / f.detect.median << ",\n"
@@ -316,7 +334,9 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
         << "      \"track_hz\": " << 1.0 / f.track.median << ",\n"
         << "      \"track_ns_per_line\": " << f.track.median * 1e9 / std::max(f.lines_tracked, 1.0) << ",\n"
         << "      \"lines_tracked\": " << f.lines_tracked << ",\n"
+        << "      \"filters_mev_s\": " << 1e-6 / f.filters.median << ",\n"
         << "      \"pipeline_mev_s\": " << 1e-6 / f.pipeline.median << ",\n"
+        << "      \"pipeline_unfiltered_mev_s\": " << 1e-6 / f.pipeline_unfiltered.median << ",\n"
         << "      \"lattice_mb\": " << f.lattice_mb << ",\n      \"events_mb\": " << f.events_mb << ",\n"
         << "      \"peak_rss_mb\": " << f.peak_rss_mb << "\n    }" << (i + 1 < results.size() ? "," : "") << "\n";
   }

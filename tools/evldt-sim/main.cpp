@@ -69,10 +69,11 @@ int run(const SimulatorOptions& sim_options, const std::filesystem::path& out_di
   const SimulatorCounters& c = simulator.counters();
   std::printf("evldt-sim summary: scene %s, %dx%d, %.3f s, seed %llu\n", scene.name.c_str(), scene.sensor.width, scene.sensor.height,
               seconds, static_cast<unsigned long long>(sim_options.config().seed));
-  std::printf("  events           %llu (%.2f Mev/s): %llu signal, %llu noise, %llu lost to the refractory period\n",
+  std::printf("  events           %llu (%.2f Mev/s): %llu signal, %llu noise, %llu lost to the refractory period, %llu to a full "
+              "readout\n",
               static_cast<unsigned long long>(events), static_cast<double>(events) * 1e-6 / seconds,
               static_cast<unsigned long long>(c.signal_events), static_cast<unsigned long long>(c.noise_events),
-              static_cast<unsigned long long>(c.refractory_losses));
+              static_cast<unsigned long long>(c.refractory_losses), static_cast<unsigned long long>(c.readout_losses));
   std::printf("  rendering        %llu sub-frames in %.2f s wall\n", static_cast<unsigned long long>(c.sub_frames), wall);
   for (const auto& path : written) std::printf("  wrote            %s\n", path.string().c_str());
   return 0;

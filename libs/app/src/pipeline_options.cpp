@@ -48,7 +48,7 @@ void PipelineOptions::add_to(CLI::App& app) {
   auto* filters = app.add_option_group("Noise filters", "Run before storage, in the order given");
   filters->add_option("--filters", filters_,
                       "Filters in order, comma-separated: hot-pixel, background-activity, refractory, anti-flicker; or none\n"
-                      "(default: hot-pixel,background-activity)");
+                      "(default: hot-pixel,anti-flicker,background-activity)");
   filters->add_option("--filter-ba-window-us", ba_window_, "background-activity: a neighbour must have fired within this")
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
   filters->add_option("--filter-refractory-us", filter_refractory_, "refractory: a pixel's events closer than this are dropped")

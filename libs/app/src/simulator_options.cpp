@@ -15,21 +15,36 @@ void SimulatorOptions::add_to(CLI::App& app, bool scene_required) {
   auto* group = app.add_option_group("Simulator", "Event-camera model of the built-in scenes");
   group->add_option("--duration-s", duration_s_, "Scene duration in seconds (default: the scene's own)")
       ->check(finite_number() & CLI::Range(0.001, 3600.0));
-  group->add_option("--seed", config_.seed, "Random seed (thresholds, noise)")->capture_default_str();
-  group->add_option("--contrast", config_.contrast_on, "Contrast threshold C+ (log intensity)")
-      ->capture_default_str()
-      ->check(finite_number() & CLI::Range(0.01, 5.0))
-      ->each([this](const std::string&) { config_.contrast_off = config_.contrast_on; });
-  group->add_option("--contrast-sigma", config_.contrast_sigma, "Per-pixel threshold spread (std dev)")
-      ->capture_default_str()
+  group->add_option("--seed", seed_, "Random seed (thresholds, noise)")->capture_default_str();
+  group->add_option("--contrast", contrast_, "Contrast threshold C+ = C- (log intensity; default 0.2)")
+      ->check(finite_number() & CLI::Range(0.01, 5.0));
+  group->add_option("--contrast-sigma", contrast_sigma_, "Per-pixel threshold spread (std dev; default 0.03, the scene's own)")
       ->check(finite_number() & CLI::Range(0.0, 1.0));
-  group->add_option("--refractory-us", config_.refractory_us, "Pixel refractory period")
-      ->capture_default_str()
+  group->add_option("--refractory-us", refractory_us_, "Pixel refractory period (default 100)")
       ->check(CLI::Range(Timestamp{0}, Timestamp{1'000'000}));
-  group->add_option("--noise-rate-hz", config_.noise_rate_hz, "Background noise events per pixel per second")
-      ->capture_default_str()
+  group->add_option("--noise-rate-hz", noise_rate_hz_, "Background noise events per pixel per second (default 0.1, the scene's own)")
       ->check(finite_number() & CLI::Range(0.0, 1000.0));
-  group->add_option("--hot-pixels", config_.hot_pixels, "Number of hot pixels")->capture_default_str()->check(CLI::Range(0, 100000));
+  group->add_option("--dark-noise-hz", dark_noise_hz_, "More background noise per pixel per second, times (1 - brightness)")
+      ->check(finite_number() & CLI::Range(0.0, 1000.0));
+  group->add_option("--hot-pixels", hot_pixels_, "Number of hot pixels (default 0, the scene's own)")->check(CLI::Range(0, 100000));
+  group->add_option("--readout-rate-eps", readout_rate_eps_, "Readout bandwidth in events/s; 0: unlimited (default, the scene's own)")
+      ->check(finite_number() & CLI::Range(0.0, 1e10));
+  group->add_option("--jitter-us", jitter_us_, "Timestamps up to this much later (default 0, the scene's own)")
+      ->check(CLI::Range(Timestamp{0}, Timestamp{100'000}));
+}
+
+SimulatorConfig SimulatorOptions::config() const {
+  SimulatorConfig config = scene_.empty() ? SimulatorConfig{} : scene_camera_model(scene_);
+  config.seed = seed_;
+  if (contrast_) config.contrast_on = config.contrast_off = *contrast_;
+  if (contrast_sigma_) config.contrast_sigma = *contrast_sigma_;
+  if (refractory_us_) config.refractory_us = *refractory_us_;
+  if (noise_rate_hz_) config.noise_rate_hz = *noise_rate_hz_;
+  if (dark_noise_hz_) config.dark_noise_hz = *dark_noise_hz_;
+  if (hot_pixels_) config.hot_pixels = *hot_pixels_;
+  if (readout_rate_eps_) config.readout_rate_eps = *readout_rate_eps_;
+  if (jitter_us_) config.timestamp_jitter_us = *jitter_us_;
+  return config;
 }
 
 Scene SimulatorOptions::scene() const {

@@ -10,7 +10,8 @@ namespace evldt {
 namespace {
 
 // Linear intensity -> log intensity, with a floor so black is finite (as a real pixel's dark current).
-float log_intensity(double brightness) { return static_cast<float>(std::log(std::max(brightness, 0.0) + 0.02)); }
+constexpr double kDarkCurrent = 0.02;
+float log_intensity(double brightness) { return static_cast<float>(std::log(std::max(brightness, 0.0) + kDarkCurrent)); }
 
 // Pixels whose centre (x + 0.5, y + 0.5) is inside the convex polygon get `value`.
 void fill_convex(const std::vector<Vec2d>& polygon, float value, int width, int height, std::vector<float>& image) {
@@ -59,25 +60,32 @@ EventSimulator::EventSimulator(Scene scene, const SimulatorConfig& config)
   for (int i = 0; i < config.hot_pixels; ++i) hot_pixels_.push_back(static_cast<std::uint32_t>(random_.below(pixels)));
   last_event_.assign(pixels, -config.refractory_us - 1);
   log_now_.resize(pixels);
-  render(0.0, log_now_);
+  render(0, log_now_);
   log_prev_ = log_now_;
   log_reference_ = log_now_;
-  const double noise_total = config.noise_rate_hz * static_cast<double>(pixels);
+  const double noise_total = (config.noise_rate_hz + std::max(0.0, config.dark_noise_hz)) * static_cast<double>(pixels);
   next_noise_s_ = noise_total > 0 ? random_.exponential(1.0 / noise_total) : 1e300;
   const double hot_total = config.hot_rate_hz * static_cast<double>(hot_pixels_.size());
   next_hot_s_ = hot_total > 0 ? random_.exponential(1.0 / hot_total) : 1e300;
 }
 
-void EventSimulator::render(double t, std::vector<float>& log_image) {
+void EventSimulator::render(Timestamp t_us, std::vector<float>& log_image) {
+  const double t = static_cast<double>(t_us) * 1e-6;
   std::fill(log_image.begin(), log_image.end(), log_intensity(scene_.background));
   for (std::size_t k = 0; k < scene_.shapes.size(); ++k) {
-    fill_convex(scene_.polygon_at(k, t), log_intensity(scene_.shapes[k].brightness), width_, height_, log_image);
+    const Shape& shape = scene_.shapes[k];
+    fill_convex(scene_.polygon_at(k, t), log_intensity(shape.brightness * shape.flicker.factor_at(t_us)), width_, height_, log_image);
   }
 }
 
 Timestamp EventSimulator::next_step() {
-  // Largest step (up to max_step_us) over which no vertex moves more than max_step_px.
+  // Largest step (up to max_step_us) over which no vertex moves more than max_step_px, ending 1 us
+  // before a light switches and then at the switch, so that its events fall at the switching time.
   Timestamp step = std::min(config_.max_step_us, scene_.duration_us - rendered_);
+  for (const Shape& shape : scene_.shapes) {
+    const Timestamp at = shape.flicker.next_switch_us(rendered_);
+    if (at - rendered_ <= step) step = at - 1 > rendered_ ? at - 1 - rendered_ : at - rendered_;
+  }
   const double t0 = static_cast<double>(rendered_) * 1e-6;
   for (int attempt = 0; attempt < 16 && step > 1; ++attempt) {
     const double t1 = static_cast<double>(rendered_ + step) * 1e-6;
@@ -123,7 +131,7 @@ void EventSimulator::emit_signal(Timestamp t0, Timestamp t1) {
 void EventSimulator::emit_noise(Timestamp t0, Timestamp t1) {
   const double end_s = static_cast<double>(t1) * 1e-6;
   const std::size_t pixels = log_now_.size();
-  const double noise_total = config_.noise_rate_hz * static_cast<double>(pixels);
+  const double noise_total = (config_.noise_rate_hz + std::max(0.0, config_.dark_noise_hz)) * static_cast<double>(pixels);
   auto fire = [&](double time_s, std::size_t pixel) {
     const Timestamp t = std::clamp<Timestamp>(static_cast<Timestamp>(std::ceil(time_s * 1e6)), t0 + 1, t1);
     pending_.push_back({t, static_cast<std::uint16_t>(pixel % static_cast<std::size_t>(width_)),
@@ -132,7 +140,13 @@ void EventSimulator::emit_noise(Timestamp t0, Timestamp t1) {
     ++counters_.noise_events;
   };
   while (next_noise_s_ <= end_s) {
-    fire(next_noise_s_, random_.below(pixels));
+    const std::size_t pixel = random_.below(pixels);
+    // Thinning: candidates come at the darkest pixel's rate; a brighter one keeps a share of them.
+    if (config_.dark_noise_hz <= 0 ||
+        random_.uniform() * (config_.noise_rate_hz + config_.dark_noise_hz) <
+            config_.noise_rate_hz + config_.dark_noise_hz * (1.0 - brightness_at(pixel))) {
+      fire(next_noise_s_, pixel);
+    }
     next_noise_s_ += random_.exponential(1.0 / noise_total);
   }
   while (next_hot_s_ <= end_s) {
@@ -141,13 +155,38 @@ void EventSimulator::emit_noise(Timestamp t0, Timestamp t1) {
   }
 }
 
+double EventSimulator::brightness_at(std::size_t pixel) const {
+  return std::clamp(std::exp(static_cast<double>(log_now_[pixel])) - kDarkCurrent, 0.0, 1.0);
+}
+
+void EventSimulator::read_out(std::size_t first) {
+  const double spacing_us = config_.readout_rate_eps > 0 ? 1e6 / config_.readout_rate_eps : 0.0;
+  std::size_t kept = first;
+  for (std::size_t i = first; i < pending_.size(); ++i) {
+    Event e = pending_[i];
+    const Timestamp jitter = config_.timestamp_jitter_us > 0 ? static_cast<Timestamp>(random_.below(
+                                                                   static_cast<std::size_t>(config_.timestamp_jitter_us) + 1))
+                                                             : 0;
+    const double leaves_us = std::max(static_cast<double>(e.t + jitter), readout_free_us_);
+    if (spacing_us > 0 && leaves_us - static_cast<double>(e.t) > static_cast<double>(config_.readout_queue_us)) {
+      ++counters_.readout_losses;
+      continue;
+    }
+    readout_free_us_ = leaves_us + spacing_us;
+    e.t = std::max(last_out_, static_cast<Timestamp>(std::ceil(leaves_us)));
+    last_out_ = e.t;
+    pending_[kept++] = e;
+  }
+  pending_.resize(kept);
+}
+
 bool EventSimulator::run_until(Timestamp until_us, EventBatch& out) {
   const Timestamp limit = std::min(until_us, scene_.duration_us);
   const std::size_t before = out.size();
   while (rendered_ < limit) {
     const Timestamp t1 = next_step();
     std::swap(log_prev_, log_now_);
-    render(static_cast<double>(t1) * 1e-6, log_now_);
+    render(t1, log_now_);
     // Drop what was handed out, then sort the new sub-frame's events behind the rest.
     pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(pending_head_));
     pending_head_ = 0;
@@ -156,6 +195,7 @@ bool EventSimulator::run_until(Timestamp until_us, EventBatch& out) {
     emit_noise(rendered_, t1);
     std::stable_sort(pending_.begin() + static_cast<std::ptrdiff_t>(first_new), pending_.end(),
                      [](const Event& a, const Event& b) { return std::tie(a.t, a.y, a.x) < std::tie(b.t, b.y, b.x); });
+    if (config_.readout_rate_eps > 0 || config_.timestamp_jitter_us > 0) read_out(first_new);
     rendered_ = t1;
     ++counters_.sub_frames;
   }

@@ -3,12 +3,34 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace evldt {
 
 double MotionChannel::at(double t) const {
   return base + rate * t + amplitude * std::sin(6.283185307179586 * frequency_hz * t + phase);
+}
+
+Timestamp Flicker::on_us(double k) const { return static_cast<Timestamp>(std::ceil(k / hz * 1e6)); }
+Timestamp Flicker::off_us(double k) const { return static_cast<Timestamp>(std::ceil((k + duty) / hz * 1e6)); }
+
+double Flicker::factor_at(Timestamp t_us) const {
+  if (hz <= 0) return 1.0;
+  // The cycle t_us falls in, by the same rounded switching times next_switch_us gives.
+  double k = std::floor(static_cast<double>(t_us) * 1e-6 * hz);
+  if (t_us < on_us(k)) k -= 1;
+  if (t_us >= on_us(k + 1)) k += 1;
+  return t_us < off_us(k) ? 1.0 : low;
+}
+
+Timestamp Flicker::next_switch_us(Timestamp after_us) const {
+  if (hz <= 0) return std::numeric_limits<Timestamp>::max();
+  const double k = std::floor(static_cast<double>(after_us) * 1e-6 * hz);
+  for (const Timestamp at : {off_us(k - 1), on_us(k), off_us(k), on_us(k + 1), off_us(k + 1)}) {
+    if (at > after_us) return at;
+  }
+  return after_us + 1;  // not reached: cycle k + 1 ends later
 }
 
 Eigen::Matrix3d Motion::homography(double t) const {

@@ -18,12 +18,16 @@ class SimulatorOptions {
   [[nodiscard]] const std::string& scene_name() const { return scene_; }
   /// The scene with the duration override applied; throws std::invalid_argument on an unknown name.
   [[nodiscard]] Scene scene() const;
-  [[nodiscard]] SimulatorConfig config() const { return config_; }
+  /// The scene's camera model (the default one without a scene), with the flags given applied.
+  [[nodiscard]] SimulatorConfig config() const;
 
  private:
   std::string scene_;
   std::optional<double> duration_s_;
-  SimulatorConfig config_;
+  std::uint64_t seed_ = 1;
+  std::optional<double> contrast_, contrast_sigma_, noise_rate_hz_, dark_noise_hz_, readout_rate_eps_;
+  std::optional<Timestamp> refractory_us_, jitter_us_;
+  std::optional<int> hot_pixels_;
 };
 
 }  // namespace evldt

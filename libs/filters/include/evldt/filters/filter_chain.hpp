@@ -13,7 +13,7 @@ namespace evldt {
 
 struct FilterConfig {
   /// Filters in the order they run: "hot-pixel", "background-activity", "refractory", "anti-flicker".
-  std::vector<std::string> chain = {"hot-pixel", "background-activity"};
+  std::vector<std::string> chain = {"hot-pixel", "anti-flicker", "background-activity"};
   Timestamp background_window_us = 5000;  ///< tuned on boxes-6dof, clean and noisy (README)
   Timestamp refractory_us = 100;
   HotPixelParams hot_pixel;

@@ -2,8 +2,10 @@
 // Event-camera model over a Scene: per-pixel log intensity rendered at sub-frame times fine enough
 // that no vertex moves more than max_step_px per step; a pixel fires each time its log intensity
 // moves a contrast threshold (C+/C-, with per-pixel spread) away from its reference, with the event
-// time interpolated linearly between the two sub-frames; a refractory period; background noise and
-// optional hot pixels. Deterministic for a seed.
+// time interpolated linearly between the two sub-frames; a refractory period; background noise
+// (more of it in the dark, if asked), optional hot pixels, flickering lights (sub-frames fall on
+// their switching times) and a readout of limited bandwidth that delays, jitters and drops events.
+// Deterministic for a seed.
 
 #include <cstdint>
 #include <vector>
@@ -20,10 +22,16 @@ struct SimulatorConfig {
   double contrast_sigma = 0.03;    ///< per-pixel spread of both thresholds (std dev, absolute)
   Timestamp refractory_us = 100;   ///< a pixel's events closer than this to its previous one are lost
   double noise_rate_hz = 0.1;      ///< background events per pixel per second
+  double dark_noise_hz = 0;        ///< more background events per pixel per second, times (1 - brightness)
   int hot_pixels = 0;              ///< pixels that fire at hot_rate_hz regardless of the scene
   double hot_rate_hz = 2000;
   double max_step_px = 0.5;        ///< largest vertex motion between two rendered sub-frames
   Timestamp max_step_us = 1000;
+  /// Readout: events leave the sensor at most this many per second, in time order, stamped when
+  /// they leave (0: no limit); an event that would wait longer than readout_queue_us is lost.
+  double readout_rate_eps = 0;
+  Timestamp readout_queue_us = 1000;
+  Timestamp timestamp_jitter_us = 0;  ///< up to this much later, uniformly (kept in time order)
   std::uint64_t seed = 1;
 };
 
@@ -31,6 +39,7 @@ struct SimulatorCounters {
   std::uint64_t signal_events = 0;
   std::uint64_t noise_events = 0;
   std::uint64_t refractory_losses = 0;
+  std::uint64_t readout_losses = 0;  ///< lost because the readout queue was full
   std::uint64_t sub_frames = 0;
 };
 
@@ -48,10 +57,14 @@ class EventSimulator {
   [[nodiscard]] const SimulatorCounters& counters() const { return counters_; }
 
  private:
-  void render(double t, std::vector<float>& log_image);
+  void render(Timestamp t_us, std::vector<float>& log_image);
   Timestamp next_step();
   void emit_signal(Timestamp t0, Timestamp t1);
   void emit_noise(Timestamp t0, Timestamp t1);
+  /// Linear brightness of a pixel in the newest sub-frame, in [0, 1].
+  [[nodiscard]] double brightness_at(std::size_t pixel) const;
+  /// Passes the sub-frame's new events (from `first`, in time order) through the readout.
+  void read_out(std::size_t first);
 
   Scene scene_;
   SimulatorConfig config_;
@@ -64,6 +77,8 @@ class EventSimulator {
   std::vector<Timestamp> last_event_;
   std::vector<std::uint32_t> hot_pixels_;
   double next_noise_s_ = 0, next_hot_s_ = 0;
+  double readout_free_us_ = 0;  // when the readout can send its next event
+  Timestamp last_out_ = 0;      // the newest time stamped on the way out
   std::vector<Event> pending_;  // events of the rendered sub-frames not handed out yet, in time order
   std::size_t pending_head_ = 0;
   SimulatorCounters counters_;

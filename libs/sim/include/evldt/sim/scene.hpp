@@ -27,11 +27,27 @@ struct Motion {
   [[nodiscard]] Eigen::Matrix3d homography(double t) const;
 };
 
+/// A light that switches between full and `low` times its brightness, as mains lights (100/120 Hz)
+/// and LED PWM do: on from k / hz for duty / hz, then low. hz 0: steady.
+struct Flicker {
+  double hz = 0;
+  double duty = 0.5;
+  double low = 0.5;
+  /// The brightness factor at time t_us: 1 from on_us(k) until off_us(k), else low.
+  [[nodiscard]] double factor_at(Timestamp t_us) const;
+  /// The first time after `after_us` at which the light switches; a steady light never does.
+  [[nodiscard]] Timestamp next_switch_us(Timestamp after_us) const;
+  /// Switching times of cycle k, whole us (rounded up, the same for both functions above).
+  [[nodiscard]] Timestamp on_us(double k) const;
+  [[nodiscard]] Timestamp off_us(double k) const;
+};
+
 struct Shape {
   std::vector<Vec2d> polygon;  ///< convex, in image coordinates at rest
   double brightness = 0.5;     ///< linear intensity in (0, 1]
   bool straight_edges = true;  ///< its edges are ground-truth lines
   Motion motion;
+  Flicker flicker;
 };
 
 /// A visible piece of a straight edge at one time.

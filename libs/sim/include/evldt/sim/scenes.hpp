@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scene.hpp"
 
 namespace evldt {
@@ -14,5 +15,8 @@ inline constexpr std::string_view kDefaultScene = "boxes-6dof";
 const std::vector<std::string>& scene_names();
 /// Throws std::invalid_argument listing the valid names for an unknown one.
 Scene make_scene(std::string_view name);
+/// The event-camera model a scene is seen through: the default for most, a noisy, flickering or
+/// dark sensor for the scenes made for those (noisy-boxes, flicker-lamps, night-boxes).
+SimulatorConfig scene_camera_model(std::string_view name);
 
 }  // namespace evldt
