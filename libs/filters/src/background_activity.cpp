@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 
@@ -10,23 +11,30 @@ constexpr Timestamp kNever = std::numeric_limits<Timestamp>::min() / 2;
 
 BackgroundActivityFilter::BackgroundActivityFilter(SensorSize sensor, Timestamp window_us)
     : EventFilter(sensor),
-      window_us_(window_us),
+      window_us_(static_cast<std::uint32_t>(window_us)),
       stride_(sensor.width + 2),
-      last_event_(static_cast<std::size_t>(sensor.width + 2) * static_cast<std::size_t>(sensor.height + 2), kNever) {
-  if (window_us <= 0) throw std::invalid_argument("the background-activity window must be positive");
+      last_event_(static_cast<std::size_t>(sensor.width + 2) * static_cast<std::size_t>(sensor.height + 2), 0) {
+  if (window_us <= 0 || window_us > 1'000'000'000) throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
 }
 
 void BackgroundActivityFilter::filter(EventBatch& batch) {
   const std::ptrdiff_t s = stride_;
+  if (!started_ && !batch.empty()) {
+    // Before the first event nothing fired: every pixel's last event lies a window before it.
+    std::fill(last_event_.begin(), last_event_.end(), static_cast<std::uint32_t>(batch.t.front()) - window_us_ - 1);
+    started_ = true;
+  }
   keep_if(batch, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
-    Timestamp* centre = last_event_.data() + (static_cast<std::ptrdiff_t>(y) + 1) * s + x + 1;
-    const Timestamp since = t - window_us_;
+    std::uint32_t* centre = last_event_.data() + (static_cast<std::ptrdiff_t>(y) + 1) * s + x + 1;
+    const auto now = static_cast<std::uint32_t>(t);
+    const auto recent = [&](std::uint32_t last) { return now - last <= window_us_; };
     // The pixel itself counts as support: a real edge often crosses a pixel's threshold twice in a
     // row, an isolated noise event rarely does (measured: on boxes-6dof this keeps F@1% at or above
     // no filter where the 8 neighbours alone cost 0.04 at a 10 ms window).
-    const bool correlated = centre[0] >= since || centre[-s - 1] >= since || centre[-s] >= since || centre[-s + 1] >= since || centre[-1] >= since ||
-                            centre[1] >= since || centre[s - 1] >= since || centre[s] >= since || centre[s + 1] >= since;
-    *centre = t;
+    const bool correlated = recent(centre[0]) || recent(centre[-s - 1]) || recent(centre[-s]) || recent(centre[-s + 1]) ||
+                            recent(centre[-1]) || recent(centre[1]) || recent(centre[s - 1]) || recent(centre[s]) ||
+                            recent(centre[s + 1]);
+    *centre = now;
     return correlated;
   });
 }

@@ -11,8 +11,7 @@ HotPixelFilter::HotPixelFilter(SensorSize sensor, const HotPixelParams& params)
       params_(params),
       min_count_(static_cast<std::uint32_t>(std::max(2.0, std::ceil(params.min_rate_hz * static_cast<double>(params.window_us) * 1e-6)))),
       release_count_(std::max<std::uint32_t>(1, min_count_ / 2)),
-      counts_(pixels(), 0),
-      masked_(pixels(), 0) {
+      counts_(pixels(), 0) {
   check_params(params);
   touched_.reserve(pixels());
 }
@@ -35,8 +34,10 @@ void HotPixelFilter::filter(EventBatch& batch) {
       window_end_ = t - window_end_ < params_.window_us ? window_end_ + params_.window_us : t + params_.window_us;
     }
     const std::size_t i = pixel(x, y);
-    if (counts_[i]++ == 0) touched_.push_back(static_cast<std::uint32_t>(i));
-    return masked_[i] == 0;
+    std::uint32_t& count = counts_[i];
+    if ((count & ~kMasked) == 0) touched_.push_back(static_cast<std::uint32_t>(i));
+    ++count;  // the count stays far below kMasked: a window of a few seconds at any real rate
+    return (count & kMasked) == 0;
   });
 }
 
@@ -44,17 +45,17 @@ void HotPixelFilter::judge_window() {
   // A masked pixel stays masked while it still fires at half the hot rate; below that it has cooled.
   still_masked_.clear();
   for (const std::uint32_t i : masked_list_) {
-    if (counts_[i] >= release_count_) {
+    if ((counts_[i] & ~kMasked) >= release_count_) {
       still_masked_.push_back(i);
     } else {
-      masked_[i] = 0;
+      counts_[i] &= ~kMasked;
     }
   }
   masked_list_.swap(still_masked_);
   const int width = sensor_.width, height = sensor_.height;
   for (const std::uint32_t i : touched_) {
-    const std::uint32_t count = counts_[i];
-    if (count < min_count_ || masked_[i] != 0) continue;
+    const std::uint32_t count = counts_[i] & ~kMasked;
+    if (count < min_count_ || (counts_[i] & kMasked) != 0) continue;
     const int x = static_cast<int>(i % static_cast<std::uint32_t>(width)), y = static_cast<int>(i / static_cast<std::uint32_t>(width));
     std::uint64_t sum = 0;
     int neighbours = 0;
@@ -62,17 +63,15 @@ void HotPixelFilter::judge_window() {
       for (int dx = -1; dx <= 1; ++dx) {
         const int nx = x + dx, ny = y + dy;
         if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-        sum += counts_[static_cast<std::size_t>(ny) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nx)];
+        sum += counts_[static_cast<std::size_t>(ny) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nx)] & ~kMasked;
         ++neighbours;
       }
     }
     const double neighbour_mean = static_cast<double>(sum) / std::max(neighbours, 1);
-    if (static_cast<double>(count) > params_.neighbour_ratio * (neighbour_mean + 1.0)) {
-      masked_[i] = 1;
-      masked_list_.push_back(i);
-    }
+    if (static_cast<double>(count) > params_.neighbour_ratio * (neighbour_mean + 1.0)) masked_list_.push_back(i);
   }
   for (const std::uint32_t i : touched_) counts_[i] = 0;
+  for (const std::uint32_t i : masked_list_) counts_[i] = kMasked;
   touched_.clear();
 }
 
