@@ -233,8 +233,7 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   EventBatch filtered;
   f.filters = per_item(time_op(once, [&] {
                          FilterChain chain(config.filters, config.lattice.sensor);
-                         filtered = events;
-                         chain.filter(filtered);
+                         chain.filter(events, filtered);
                        }),
                        n);
   f.pipeline = per_item(time_op(once, [&] {

@@ -75,8 +75,8 @@ bool AntiFlickerFilter::pass(Timestamp t, std::size_t pixel, bool on) {
   return false;
 }
 
-void AntiFlickerFilter::filter(EventBatch& batch) {
-  keep_if(batch, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t p) { return pass(t, pixel(x, y), p > 0); });
+void AntiFlickerFilter::filter(const EventBatch& in, EventBatch& out) {
+  keep_if(in, out, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t p) { return pass(t, pixel(x, y), p > 0); });
 }
 
 }  // namespace evldt

@@ -17,14 +17,14 @@ BackgroundActivityFilter::BackgroundActivityFilter(SensorSize sensor, Timestamp 
   if (window_us <= 0 || window_us > 1'000'000'000) throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
 }
 
-void BackgroundActivityFilter::filter(EventBatch& batch) {
+void BackgroundActivityFilter::filter(const EventBatch& in, EventBatch& out) {
   const std::ptrdiff_t s = stride_;
-  if (!started_ && !batch.empty()) {
+  if (!started_ && !in.empty()) {
     // Before the first event nothing fired: every pixel's last event lies a window before it.
-    std::fill(last_event_.begin(), last_event_.end(), static_cast<std::uint32_t>(batch.t.front()) - window_us_ - 1);
+    std::fill(last_event_.begin(), last_event_.end(), static_cast<std::uint32_t>(in.t.front()) - window_us_ - 1);
     started_ = true;
   }
-  keep_if(batch, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
+  keep_if(in, out, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
     std::uint32_t* centre = last_event_.data() + (static_cast<std::ptrdiff_t>(y) + 1) * s + x + 1;
     const auto now = static_cast<std::uint32_t>(t);
     const auto recent = [&](std::uint32_t last) { return now - last <= window_us_; };
@@ -44,8 +44,8 @@ RefractoryFilter::RefractoryFilter(SensorSize sensor, Timestamp period_us)
   if (period_us <= 0) throw std::invalid_argument("the refractory period must be positive");
 }
 
-void RefractoryFilter::filter(EventBatch& batch) {
-  keep_if(batch, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
+void RefractoryFilter::filter(const EventBatch& in, EventBatch& out) {
+  keep_if(in, out, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
     Timestamp& last = last_passed_[pixel(x, y)];
     if (t - last < period_us_) return false;
     last = t;

@@ -60,13 +60,15 @@ FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) {
   }
 }
 
-void FilterChain::filter(EventBatch& batch) {
-  events_in_ += batch.size();
+void FilterChain::filter(const EventBatch& in, EventBatch& out) {
+  events_in_ += in.size();
+  // The first filter copies what passes, the others filter that copy in place.
+  const EventBatch* from = &in;
   for (const auto& filter : filters_) {
-    if (batch.empty()) break;
-    filter->filter(batch);
+    filter->filter(*from, out);
+    from = &out;
   }
-  passed_ += batch.size();
+  passed_ += out.size();
 }
 
 FilterCounts FilterChain::counts() const {

@@ -22,8 +22,8 @@ void check_params(const HotPixelParams& params) {
   }
 }
 
-void HotPixelFilter::filter(EventBatch& batch) {
-  keep_if(batch, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
+void HotPixelFilter::filter(const EventBatch& in, EventBatch& out) {
+  keep_if(in, out, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
     if (!started_) {
       started_ = true;
       window_end_ = t + params_.window_us;

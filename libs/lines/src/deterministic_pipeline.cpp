@@ -60,8 +60,7 @@ void DeterministicPipeline::process(const EventBatch& batch) {
   if (filters_.empty()) {
     store(batch);
   } else {
-    filtered_ = batch;  // vector assignment reuses the capacity: no allocation once warm
-    filters_.filter(filtered_);
+    filters_.filter(batch, filtered_);
     store(filtered_);
   }
   // Rounds due up to the batch's last event: every stored event is older than them (store() ran

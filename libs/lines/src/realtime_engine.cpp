@@ -54,8 +54,7 @@ void RealtimeEngine::process(const EventBatch& input) {
   const EventBatch* stored = &input;
   if (!filters_.empty()) {
     std::lock_guard lock(filter_mutex_);
-    filtered_ = input;  // vector assignment reuses the capacity: no allocation once warm
-    filters_.filter(filtered_);
+    filters_.filter(input, filtered_);
     stored = &filtered_;
   }
   const EventBatch& batch = *stored;

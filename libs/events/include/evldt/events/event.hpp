@@ -73,7 +73,7 @@ class EventBatch {
     y.push_back(py);
     p.push_back(polarity);
   }
-  /// Keeps the first n events.
+  /// Keeps the first n events (or grows to n, the new ones zero).
   void truncate(std::size_t n) {
     t.resize(n);
     x.resize(n);

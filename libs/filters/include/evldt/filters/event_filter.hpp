@@ -16,30 +16,35 @@ class EventFilter {
   virtual ~EventFilter() = default;
   /// The filter's name, which is also the reason its drops are counted under.
   [[nodiscard]] virtual std::string_view name() const = 0;
-  /// Removes from `batch` the events that do not pass, keeping the order of the rest.
-  virtual void filter(EventBatch& batch) = 0;
+  /// Writes to `out` the events of `in` that pass, in order; `out` may be `in` (filtered in place).
+  /// Once `out` has held a batch as large, no allocation.
+  virtual void filter(const EventBatch& in, EventBatch& out) = 0;
   /// Events this filter has removed so far.
   [[nodiscard]] std::uint64_t dropped() const { return dropped_; }
 
  protected:
   explicit EventFilter(SensorSize sensor) : sensor_(sensor) {}
 
-  /// Keeps the events i for which pass(t, x, y, p) is true, in order, and counts the others. A
-  /// template, so that each filter's test inlines into the loop.
+  /// Copies the events of `in` for which pass(t, x, y, p) is true to `out` (which may be `in`), in
+  /// order, and counts the others. A template, so that each filter's test inlines into the loop.
   template <typename Pass>
-  void keep_if(EventBatch& batch, Pass&& pass) {
+  void keep_if(const EventBatch& in, EventBatch& out, Pass&& pass) {
+    const std::size_t size = in.size();
+    if (&in != &out) out.truncate(size);  // room for every event: no allocation once warm
     std::size_t kept = 0;
-    const std::size_t size = batch.size();
     for (std::size_t i = 0; i < size; ++i) {
-      if (!pass(batch.t[i], batch.x[i], batch.y[i], batch.p[i])) continue;
-      batch.t[kept] = batch.t[i];
-      batch.x[kept] = batch.x[i];
-      batch.y[kept] = batch.y[i];
-      batch.p[kept] = batch.p[i];
+      const Timestamp t = in.t[i];
+      const std::uint16_t x = in.x[i], y = in.y[i];
+      const std::int8_t p = in.p[i];
+      if (!pass(t, x, y, p)) continue;
+      out.t[kept] = t;
+      out.x[kept] = x;
+      out.y[kept] = y;
+      out.p[kept] = p;
       ++kept;
     }
     dropped_ += size - kept;
-    batch.truncate(kept);
+    out.truncate(kept);
   }
   [[nodiscard]] std::size_t pixel(std::uint16_t x, std::uint16_t y) const {
     return static_cast<std::size_t>(y) * static_cast<std::size_t>(sensor_.width) + x;

@@ -55,8 +55,9 @@ class FilterChain {
  public:
   /// Throws std::invalid_argument for an unknown filter or a parameter out of range.
   FilterChain(const FilterConfig& config, SensorSize sensor);
-  /// Removes what the filters drop from `batch` (on-sensor events in time order), in order.
-  void filter(EventBatch& batch);
+  /// Writes to `out` the events of `in` (on-sensor, in time order) that pass every filter, in order;
+  /// `out` may be `in`. The chain must not be empty.
+  void filter(const EventBatch& in, EventBatch& out);
   [[nodiscard]] bool empty() const { return filters_.empty(); }
   [[nodiscard]] FilterCounts counts() const;
   /// The pixels the hot-pixel filter masks now (y * width + x); empty without that filter.

@@ -20,7 +20,7 @@ class BackgroundActivityFilter final : public EventFilter {
  public:
   BackgroundActivityFilter(SensorSize sensor, Timestamp window_us);
   [[nodiscard]] std::string_view name() const override { return "background-activity"; }
-  void filter(EventBatch& batch) override;
+  void filter(const EventBatch& in, EventBatch& out) override;
 
  private:
   std::uint32_t window_us_;
@@ -35,7 +35,7 @@ class RefractoryFilter final : public EventFilter {
  public:
   RefractoryFilter(SensorSize sensor, Timestamp period_us);
   [[nodiscard]] std::string_view name() const override { return "refractory"; }
-  void filter(EventBatch& batch) override;
+  void filter(const EventBatch& in, EventBatch& out) override;
 
  private:
   Timestamp period_us_;
@@ -55,7 +55,7 @@ class HotPixelFilter final : public EventFilter {
  public:
   HotPixelFilter(SensorSize sensor, const HotPixelParams& params);
   [[nodiscard]] std::string_view name() const override { return "hot-pixel"; }
-  void filter(EventBatch& batch) override;
+  void filter(const EventBatch& in, EventBatch& out) override;
   /// The masked pixels (y * width + x), in the order they were masked.
   [[nodiscard]] std::span<const std::uint32_t> masked_pixels() const { return masked_list_; }
 
@@ -89,7 +89,7 @@ class AntiFlickerFilter final : public EventFilter {
  public:
   AntiFlickerFilter(SensorSize sensor, const AntiFlickerParams& params);
   [[nodiscard]] std::string_view name() const override { return "anti-flicker"; }
-  void filter(EventBatch& batch) override;
+  void filter(const EventBatch& in, EventBatch& out) override;
 
  private:
   // Per pixel and polarity, 12 bytes. Times are the low 32 bits of us: differences are exact for
