@@ -325,6 +325,16 @@ TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
   list.height = 180;
   publish_raw(lcm, "LINES_CAM0", encode(list));
   publish_raw(lcm, "LINES_CAM0", {1, 2, 3});  // refused, counted
+  stats_t stats{};  // evldt-lines masks the hot pixel (200, 40); evldt-camera's statistics are not drawn
+  stats.service = "evldt-lines";
+  stats.source = "cam0";
+  stats.masked_pixels = {40 * 240 + 200};
+  stats.num_masked_pixels = 1;
+  publish_raw(lcm, std::string(kStatsChannel), encode(stats));
+  stats.service = "evldt-camera";
+  stats.masked_pixels.clear();
+  stats.num_masked_pixels = 0;
+  publish_raw(lcm, std::string(kStatsChannel), encode(stats));
 
   cv::Mat last;
   const std::atomic<bool> never{false};
@@ -347,6 +357,11 @@ TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
   }
   EXPECT_GT(green, 100);
   EXPECT_LT(red, 60);
+  // The masked pixel is ringed in magenta (radius 6 at scale 2, centred on the pixel).
+  const cv::Vec3b ring = last.at<cv::Vec3b>(2 * 40 + 1, 2 * 200 + 1 + 6);
+  EXPECT_GT(ring[0], 100);
+  EXPECT_GT(ring[2], 100);
+  EXPECT_LT(ring[1], 60);
 }
 
 // A frame that takes longer than its period (a slow machine, a big sensor at a high --fps) must not
