@@ -51,7 +51,7 @@ bool AntiFlickerFilter::pass(Timestamp t, std::size_t pixel, bool on) {
     const std::uint32_t period = burst.period;
     const std::uint32_t n = (since + period / 2) / period;
     if (n >= 1 && n <= 3 && near(since, n * period)) {
-      if (n == 1) burst.period = static_cast<std::uint16_t>(since);  // follows a drifting frequency
+      if (n == 1 && since <= max_period_) burst.period = static_cast<std::uint16_t>(since);  // follows a drifting frequency
       burst.start = now;
       burst.flags |= kFlickerBurst;
       return false;
