@@ -54,7 +54,7 @@ void add_sweeping_edge(std::vector<Tagged>& events, Timestamp t0, Timestamp colu
 }
 
 TEST(BackgroundActivity, CorrelatedEdgeEventsPassIsolatedEventsDrop) {
-  BackgroundActivityFilter filter(kSensor, 2000);
+  BackgroundActivityFilter filter(kSensor, 2000, /*min_noise_hz=*/0);
   std::vector<Tagged> events;
   add_sweeping_edge(events, 10'000, 500, /*tag=*/0);
   // Isolated events: pixels far apart, each alone in its neighbourhood for far longer than the window.
@@ -65,6 +65,26 @@ TEST(BackgroundActivity, CorrelatedEdgeEventsPassIsolatedEventsDrop) {
   EXPECT_GE(counts.at(0).first, counts.at(0).second - 1);  // all but the very first event of the edge
   EXPECT_EQ(counts.at(1).first, 0);
   EXPECT_EQ(filter.dropped(), static_cast<std::uint64_t>(counts.at(0).second - counts.at(0).first + 200));
+}
+
+/// Isolated events at `hz` per pixel over the whole sensor, each alone in its neighbourhood.
+void add_uncorrelated(std::vector<Tagged>& events, double hz, Timestamp from, Timestamp to, int tag) {
+  const auto spacing = static_cast<Timestamp>(1e6 / (hz * kSensor.width * kSensor.height));
+  int i = 0;
+  for (Timestamp t = from; t < to; t += spacing, ++i) {
+    events.push_back({{t, static_cast<std::uint16_t>((i * 37) % 64), static_cast<std::uint16_t>((i * 23) % 48), 1}, tag});
+  }
+}
+
+TEST(BackgroundActivity, DropsUncorrelatedEventsOnlyWhileTheSensorIsNoisy) {
+  BackgroundActivityFilter filter(kSensor, 2000, /*min_noise_hz=*/1.0);
+  std::vector<Tagged> events;
+  add_uncorrelated(events, 0.3, 0, 1'000'000, /*tag=*/0);          // a clean sensor's sparse events: kept
+  add_uncorrelated(events, 5.0, 1'000'000, 1'200'000, /*tag=*/1);  // noise begins: judged over 200 ms
+  add_uncorrelated(events, 5.0, 1'200'000, 2'000'000, /*tag=*/2);  // then dropped
+  const auto counts = passed_by_tag(filter, events);
+  EXPECT_EQ(counts.at(0).first, counts.at(0).second);
+  EXPECT_LE(counts.at(2).first, counts.at(2).second / 50);
 }
 
 TEST(Refractory, APixelFiresAtMostOncePerPeriod) {
@@ -155,6 +175,7 @@ TEST(AntiFlicker, FlickerOutsideTheBandAndIrregularEventsPass) {
 TEST(FilterChain, RunsInOrderAndCountsEachReason) {
   FilterConfig config;
   config.chain = parse_filter_chain("refractory,background-activity");
+  config.background_min_noise_hz = 0;  // always on
   FilterChain chain(config, kSensor);
   EventBatch batch;
   batch.push_back(100, 5, 5, 1);

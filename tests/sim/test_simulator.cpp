@@ -262,3 +262,34 @@ TEST(EventSimulator, TheBuiltInScenesOfEarlierReleasesGiveTheSameEvents) {
 
 }  // namespace
 }  // namespace evldt
+
+namespace evldt {
+namespace {
+
+TEST(Scenes, AGroundTruthIdFollowsOneEdgeThroughOcclusionAndClippingForTenSeconds) {
+  for (const char* name : {"boxes-10s", "poster-10s"}) {
+    const Scene scene = make_scene(name);
+    ASSERT_GE(scene.duration_us, 10'000'000) << name;
+    std::map<int, std::pair<Vec2d, Vec2d>> previous;  // gt_id -> a piece at the previous step
+    std::size_t compared = 0;
+    for (Timestamp t = 0; t <= scene.duration_us; t += 10'000) {
+      std::map<int, std::pair<Vec2d, Vec2d>> now;
+      for (const GtSegment& edge : scene.visible_edges(t)) {
+        now.emplace(edge.gt_id, std::make_pair(edge.a, edge.b));  // the first piece of a split edge
+        const auto before = previous.find(edge.gt_id);
+        if (before == previous.end()) continue;
+        // Every piece lies on (nearly) the line its id had 10 ms before: the id never jumps to another edge.
+        const Vec2d p = before->second.first, d = (before->second.second - p).normalized();
+        const Vec2d n(-d.y(), d.x());
+        EXPECT_LT(std::abs((edge.a - p).dot(n)), 2.0) << name << " id " << edge.gt_id << " at " << t;
+        EXPECT_LT(std::abs((edge.b - p).dot(n)), 2.0) << name << " id " << edge.gt_id << " at " << t;
+        ++compared;
+      }
+      previous = std::move(now);
+    }
+    EXPECT_GT(compared, 10000u) << name;
+  }
+}
+
+}  // namespace
+}  // namespace evldt

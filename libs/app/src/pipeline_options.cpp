@@ -51,6 +51,9 @@ void PipelineOptions::add_to(CLI::App& app) {
                       "(default: hot-pixel,anti-flicker,background-activity)");
   filters->add_option("--filter-ba-window-us", ba_window_, "background-activity: a neighbour must have fired within this")
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
+  filters->add_option("--filter-ba-min-noise-hz", ba_min_noise_hz_,
+                      "background-activity: drop only while uncorrelated events come at this rate per pixel or more (0: always)")
+      ->check(finite_number() & CLI::Range(0.0, 1000.0));
   filters->add_option("--filter-refractory-us", filter_refractory_, "refractory: a pixel's events closer than this are dropped")
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
   filters->add_option("--filter-hot-window-us", hot_window_, "hot-pixel: rates are judged over windows of this event time")
@@ -90,6 +93,7 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   if (detect_period_) config.schedule.detect_period_us = *detect_period_;
   if (filters_) config.filters.chain = parse_filter_chain(*filters_);
   if (ba_window_) config.filters.background_window_us = *ba_window_;
+  if (ba_min_noise_hz_) config.filters.background_min_noise_hz = *ba_min_noise_hz_;
   if (filter_refractory_) config.filters.refractory_us = *filter_refractory_;
   if (hot_window_) config.filters.hot_pixel.window_us = *hot_window_;
   if (hot_rate_) config.filters.hot_pixel.min_rate_hz = *hot_rate_;

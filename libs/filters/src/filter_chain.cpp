@@ -38,6 +38,7 @@ void check_filter_config(const FilterConfig& config) {
     if (std::ranges::find(filter_names(), name) == filter_names().end()) throw std::invalid_argument("unknown filter '" + name + "'");
   }
   if (config.background_window_us <= 0) throw std::invalid_argument("the background-activity window must be positive");
+  if (!(config.background_min_noise_hz >= 0)) throw std::invalid_argument("the background-activity noise level must not be negative");
   if (config.refractory_us <= 0) throw std::invalid_argument("the refractory period must be positive");
   check_params(config.hot_pixel);
   check_params(config.anti_flicker);
@@ -51,7 +52,7 @@ FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) {
       hot_pixel_ = filter.get();
       filters_.push_back(std::move(filter));
     } else if (name == "background-activity") {
-      filters_.push_back(std::make_unique<BackgroundActivityFilter>(sensor, config.background_window_us));
+      filters_.push_back(std::make_unique<BackgroundActivityFilter>(sensor, config.background_window_us, config.background_min_noise_hz));
     } else if (name == "refractory") {
       filters_.push_back(std::make_unique<RefractoryFilter>(sensor, config.refractory_us));
     } else {

@@ -143,11 +143,54 @@ Scene night_boxes() {
   return s;
 }
 
+// Ten-second scenes for tracks that last (issue 15), like the seed paper's 10 s sequences.
+
+// boxes-6dof's boxes under a 10 s camera motion of other frequencies and phases.
+Scene boxes_10s() {
+  Scene s = boxes_6dof();
+  s.name = "boxes-10s";
+  s.duration_us = 10'000'000;
+  s.camera.tx = {0, 0, 22, 0.23, 1.3};
+  s.camera.ty = {0, 0, 14, 0.31, 0.4};
+  s.camera.angle = sine(0.18, 0.17, 2.1);
+  s.camera.log_scale = sine(0.1, 0.13, 0.7);
+  s.camera.perspective_x = sine(3.5e-4, 0.11, 1.1);
+  s.camera.perspective_y = sine(2.5e-4, 0.09, 2.5);
+  return s;
+}
+
+// A textured planar poster (rectangles and triangles of many greys) under smooth 6-DoF camera motion
+// for 10 s, at DAVIS346's size.
+Scene poster_10s() {
+  Scene s{"poster-10s", {346, 260}, 0.5, {}, {}, 10'000'000};
+  s.shapes.push_back(solid(rectangle(28, 20, 318, 240), 0.8));
+  const double greys[] = {0.1, 0.35, 0.95, 0.2, 0.6, 0.05, 0.45, 0.9, 0.25};
+  int k = 0;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col, ++k) {
+      const double x = 45 + col * 95, y = 35 + row * 68;
+      if ((row + col) % 2 == 0) {
+        s.shapes.push_back(solid(rectangle(x, y, x + 70, y + 48), greys[k]));
+      } else {
+        s.shapes.push_back(solid({{x + 35, y}, {x + 72, y + 50}, {x - 2, y + 50}}, greys[k]));
+      }
+    }
+  }
+  s.camera.pivot = {173, 130};
+  s.camera.tx = {0, 0, 24, 0.21, 0.3};
+  s.camera.ty = {0, 0, 16, 0.27, 1.7};
+  s.camera.angle = sine(0.15, 0.15, 0.9);
+  s.camera.log_scale = sine(0.1, 0.12, 2.4);
+  s.camera.perspective_x = sine(4e-4, 0.1, 0.2);
+  s.camera.perspective_y = sine(3e-4, 0.08, 1.9);
+  return s;
+}
+
 }  // namespace
 
 const std::vector<std::string>& scene_names() {
   static const std::vector<std::string> names{"three-lines-fast", "circle-board", "boxes-6dof", "multi-speed", "monitor-hd",
-                                              "noisy-boxes", "flicker-lamps", "night-boxes"};
+                                              "noisy-boxes", "flicker-lamps", "night-boxes", "boxes-10s", "poster-10s"};
   return names;
 }
 
@@ -179,6 +222,8 @@ Scene make_scene(std::string_view name) {
   if (name == "noisy-boxes") return noisy_boxes();
   if (name == "flicker-lamps") return flicker_lamps();
   if (name == "night-boxes") return night_boxes();
+  if (name == "boxes-10s") return boxes_10s();
+  if (name == "poster-10s") return poster_10s();
   std::string valid;
   for (const auto& n : scene_names()) valid += (valid.empty() ? "" : ", ") + n;
   throw std::invalid_argument("unknown scene '" + std::string(name) + "' (built-in scenes: " + valid + ")");

@@ -31,7 +31,7 @@ class PipelineOptions {
   std::optional<Timestamp> track_period_, detect_period_;
   std::optional<std::string> filters_;
   std::optional<Timestamp> ba_window_, filter_refractory_, hot_window_;
-  std::optional<double> hot_rate_, hot_ratio_, flicker_min_hz_, flicker_max_hz_;
+  std::optional<double> ba_min_noise_hz_, hot_rate_, hot_ratio_, flicker_min_hz_, flicker_max_hz_;
   Timestamp time_slack_us_ = 1000;
 };
 

@@ -15,6 +15,7 @@ struct FilterConfig {
   /// Filters in the order they run: "hot-pixel", "background-activity", "refractory", "anti-flicker".
   std::vector<std::string> chain = {"hot-pixel", "anti-flicker", "background-activity"};
   Timestamp background_window_us = 5000;  ///< tuned on boxes-6dof, clean and noisy (README)
+  double background_min_noise_hz = 1.0;    ///< background-activity drops only above this uncorrelated rate per pixel
   Timestamp refractory_us = 100;
   HotPixelParams hot_pixel;
   AntiFlickerParams anti_flicker;

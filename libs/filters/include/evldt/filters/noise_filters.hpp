@@ -1,7 +1,8 @@
 #pragma once
 // The noise filters (DESIGN 8: noise before storage):
 //   background-activity: the spatio-temporal correlation filter; an event passes when its pixel or
-//     one of its 8 neighbours fired within a time window (isolated thermal / leak events did not);
+//     one of its 8 neighbours fired within a time window (isolated thermal / leak events did not),
+//     while the sensor is noisy enough for that to pay;
 //   refractory: a pixel's events closer than a period to its previous passed one are dropped;
 //   hot-pixel: learns pixels that fire far above their neighbourhood and masks them, releasing a
 //     pixel that cools;
@@ -18,7 +19,10 @@ namespace evldt {
 
 class BackgroundActivityFilter final : public EventFilter {
  public:
-  BackgroundActivityFilter(SensorSize sensor, Timestamp window_us);
+  /// Drops uncorrelated events only while they come at `min_noise_hz` per pixel or more (judged over
+  /// each 200 ms of event time, applied to the next): a clean sensor's uncorrelated events are mostly
+  /// the sparse edges of slow or faint motion, which the lattice needs (0: always drop them).
+  BackgroundActivityFilter(SensorSize sensor, Timestamp window_us, double min_noise_hz);
   [[nodiscard]] std::string_view name() const override { return "background-activity"; }
   void filter(const EventBatch& in, EventBatch& out) override;
 
@@ -29,6 +33,11 @@ class BackgroundActivityFilter final : public EventFilter {
   // full times, and differences are exact for gaps under 71 minutes.
   std::vector<std::uint32_t> last_event_;
   bool started_ = false;
+  static constexpr Timestamp kJudgeUs = 200'000;
+  double min_uncorrelated_;      // per judging period
+  Timestamp judge_end_ = 0;
+  std::uint64_t uncorrelated_ = 0;
+  bool active_ = true;
 };
 
 class RefractoryFilter final : public EventFilter {
