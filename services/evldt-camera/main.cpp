@@ -1,5 +1,5 @@
 // evldt-camera: publishes event batches from a recording, a built-in scene or a video on
-// EVENTS_<CAMERA>, paced at real time or a speed factor.
+// EVENTS_<CAMERA>, paced at real time or a speed factor, and its statistics on EVLDT_STATS.
 
 #include <CLI/CLI.hpp>
 #include <spdlog/fmt/fmt.h>
@@ -12,8 +12,9 @@
 
 int main(int argc, char** argv) {
   using namespace evldt;
-  CLI::App app{"evldt-camera: publish camera events over LCM on EVENTS_<CAMERA> (evldt.event_batch_t).\n"
-               "Sources: a recording (ECD events.txt, EVT 2.0/3.0 RAW, .dat, lcm-log), a built-in --scene, or\n"
+  CLI::App app{"evldt-camera: publish camera events over LCM on EVENTS_<CAMERA> (evldt.event_batch_t), and its\n"
+               "statistics (evldt.stats_t, once a second: events, drops, words the decoder skipped) on EVLDT_STATS.\n"
+               "Sources: a recording in any format evldt reads (see input), a built-in --scene, or\n"
                "--from-video FILE|WEBCAM_INDEX by frame differencing. Prints progress and a summary.\n"
                "Exit status: 0 done or stopped by SIGINT/SIGTERM, 1 bad usage or setup, 2 corrupt input."};
   LcmOptions lcm_options;
