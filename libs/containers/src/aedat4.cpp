@@ -2,11 +2,11 @@
 
 #include <flatbuffers/flatbuffers.h>
 
-#include <fstream>
 #include <map>
 #include <stdexcept>
 
 #include "aedat4_header_generated.h"
+#include "container_file.hpp"
 #include "decompress.hpp"
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_format.hpp"
@@ -78,19 +78,16 @@ std::map<int, StreamInfo> parse_streams(std::string_view xml) {
 
 class Aedat4Source final : public PacketSource {
  public:
-  explicit Aedat4Source(const std::filesystem::path& path) : path_(path.string()), file_(path, std::ios::binary) {
-    if (!file_) throw std::runtime_error("cannot open AEDAT 4 file '" + path_ + "'");
-    std::error_code size_error;
-    file_size_ = std::filesystem::file_size(path, size_error);
+  explicit Aedat4Source(const std::filesystem::path& path) : file_(path, "AEDAT 4"), path_(file_.path()) {
     std::string magic(kAedat4Magic.size(), '\0');
-    read_exactly(magic.data(), magic.size(), "the version line");
+    file_.read_exactly(magic.data(), magic.size(), "the version line");
     if (magic != kAedat4Magic) throw FormatError(path_, 0, "not an AEDAT 4.0 file");
     std::vector<std::uint8_t> header(4);
-    read_exactly(header.data(), 4, "the header size");
+    file_.read_exactly(header.data(), 4, "the header size");
     const std::uint32_t header_size = detail::load_le32(header.data());
-    if (header_size > detail::kMaxDecompressedBytes) throw FormatError(path_, position_ - 4, "header size " + std::to_string(header_size));
+    if (header_size > detail::kMaxDecompressedBytes) throw FormatError(path_, file_.position() - 4, "header size " + std::to_string(header_size));
     header.resize(4 + header_size);
-    read_exactly(header.data() + 4, header_size, "the header");
+    file_.read_exactly(header.data() + 4, header_size, "the header");
     flatbuffers::Verifier verifier(header.data(), header.size());
     if (!aedat4::VerifySizePrefixedIOHeaderBuffer(verifier)) {
       throw FormatError(path_, kAedat4Magic.size(), "the header is not a valid IOHeader FlatBuffer");
@@ -100,7 +97,7 @@ class Aedat4Source final : public PacketSource {
     if (compression_ < aedat4::CompressionType::NONE || compression_ > aedat4::CompressionType::ZSTD_HIGH) {
       throw FormatError(path_, kAedat4Magic.size(), "unknown compression " + std::to_string(static_cast<int>(compression_)));
     }
-    data_end_ = io->dataTablePosition() >= 0 ? static_cast<std::uint64_t>(io->dataTablePosition()) : file_size_;
+    data_end_ = io->dataTablePosition() >= 0 ? static_cast<std::uint64_t>(io->dataTablePosition()) : file_.size();
     const auto streams = parse_streams(io->infoNode() ? io->infoNode()->string_view() : std::string_view());
     for (const auto& [id, stream] : streams) {
       if (stream.type == "EVTS") {
@@ -114,23 +111,22 @@ class Aedat4Source final : public PacketSource {
   }
 
   bool next(RecordingPacket& packet) override {
-    while (position_ + 8 <= data_end_) {
+    while (file_.position() + 8 <= data_end_) {
       std::uint8_t header[8];
-      const std::uint64_t at = position_;
-      read_exactly(header, 8, "a packet header");
+      const std::uint64_t at = file_.position();
+      file_.read_exactly(header, 8, "a packet header");
       const auto stream = static_cast<std::int32_t>(detail::load_le32(header));
       const std::uint32_t size = detail::load_le32(header + 4);
-      if (size > detail::kMaxDecompressedBytes || position_ + size > data_end_) {
+      if (size > detail::kMaxDecompressedBytes || file_.position() + size > data_end_) {
         throw FormatError(path_, at, "packet of " + std::to_string(size) + " bytes does not fit in the file");
       }
       if (stream != stream_id_) {
-        file_.seekg(static_cast<std::streamoff>(size), std::ios::cur);
-        position_ += size;
+        file_.skip(size);
         ++skipped_;
         continue;
       }
       compressed_.resize(size);
-      read_exactly(compressed_.data(), size, "a packet");
+      file_.read_exactly(compressed_.data(), size, "a packet");
       packet.location = "byte " + std::to_string(at);
       try {
         decompress(packet.bytes);
@@ -142,8 +138,8 @@ class Aedat4Source final : public PacketSource {
       packet.sensor = sensor_;
       return true;
     }
-    if (position_ < data_end_ && data_end_ == file_size_) {
-      throw FormatError(path_, position_, "file ends inside a packet header (a recording cut short)");
+    if (file_.position() < data_end_ && data_end_ == file_.size()) {
+      throw FormatError(path_, file_.position(), "file ends inside a packet header (a recording cut short)");
     }
     return false;
   }
@@ -154,18 +150,12 @@ class Aedat4Source final : public PacketSource {
     return "AEDAT 4.0, stream " + std::to_string(stream_id_) + " (polarity events, " + compression_name() + ")";
   }
   [[nodiscard]] double progress() const override {
-    return data_end_ == 0 ? 1.0 : static_cast<double>(position_) / static_cast<double>(data_end_);
+    return data_end_ == 0 ? 1.0 : static_cast<double>(file_.position()) / static_cast<double>(data_end_);
   }
   [[nodiscard]] std::uint64_t skipped_packets() const override { return skipped_; }
 
  private:
-  void read_exactly(void* out, std::size_t size, const char* what) {
-    file_.read(static_cast<char*>(out), static_cast<std::streamsize>(size));
-    if (static_cast<std::size_t>(file_.gcount()) != size) {
-      throw FormatError(path_, position_ + static_cast<std::uint64_t>(file_.gcount()), std::string("file ends inside ") + what);
-    }
-    position_ += size;
-  }
+
 
   [[nodiscard]] std::string compression_name() const { return aedat4::EnumNameCompressionType(compression_); }
 
@@ -179,10 +169,8 @@ class Aedat4Source final : public PacketSource {
     }
   }
 
+  detail::ContainerFile file_;
   std::string path_;
-  std::ifstream file_;
-  std::uint64_t file_size_ = 0;
-  std::uint64_t position_ = 0;
   std::uint64_t data_end_ = 0;
   aedat4::CompressionType compression_ = aedat4::CompressionType::NONE;
   int stream_id_ = -1;

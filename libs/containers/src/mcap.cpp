@@ -2,11 +2,11 @@
 
 #include <zlib.h>
 
-#include <fstream>
 #include <map>
 #include <stdexcept>
 #include <vector>
 
+#include "container_file.hpp"
 #include "decompress.hpp"
 #include "evldt/containers/ros_messages.hpp"
 #include "evldt/events/event_decoder.hpp"
@@ -60,12 +60,9 @@ struct Channel {
 class McapSource final : public PacketSource {
  public:
   McapSource(const std::filesystem::path& path, const std::string& topic)
-      : path_(path.string()), wanted_(topic), file_(path, std::ios::binary) {
-    if (!file_) throw std::runtime_error("cannot open MCAP file '" + path_ + "'");
-    std::error_code size_error;
-    file_size_ = std::filesystem::file_size(path, size_error);
+      : file_(path, "MCAP"), path_(file_.path()), wanted_(topic) {
     std::string magic(kMcapMagic.size(), '\0');
-    read_exactly(magic.data(), magic.size(), "the magic");
+    file_.read_exactly(magic.data(), magic.size(), "the magic");
     if (magic != kMcapMagic) throw FormatError(path_, 0, "not an MCAP file");
     // A channel is described before its first message: read on until the one to use.
     Record record;
@@ -104,7 +101,7 @@ class McapSource final : public PacketSource {
   [[nodiscard]] std::string camera() const override { return camera_; }
   [[nodiscard]] std::string description() const override { return "MCAP, " + topic_ + " (" + type_ + ")"; }
   [[nodiscard]] double progress() const override {
-    return file_size_ == 0 ? 1.0 : static_cast<double>(position_) / static_cast<double>(file_size_);
+    return file_.size() == 0 ? 1.0 : static_cast<double>(file_.position()) / static_cast<double>(file_.size());
   }
   [[nodiscard]] std::uint64_t skipped_packets() const override { return skipped_; }
 
@@ -126,17 +123,17 @@ class McapSource final : public PacketSource {
     }
     if (at_end_) return false;
     std::uint8_t header[9];
-    record.offset = position_;
-    if (position_ == file_size_) throw FormatError(path_, position_, "file ends without its footer (a recording cut short)");
-    read_exactly(header, sizeof header, "a record header");
+    record.offset = file_.position();
+    if (file_.position() == file_.size()) throw FormatError(path_, file_.position(), "file ends without its footer (a recording cut short)");
+    file_.read_exactly(header, sizeof header, "a record header");
     FieldReader fields{std::span<const std::uint8_t>(header)};
     record.opcode = fields.read<std::uint8_t>();
     const auto length = fields.read<std::uint64_t>();
-    if (length > file_size_ - position_ || length > detail::kMaxDecompressedBytes) {
+    if (length > file_.size() - file_.position() || length > detail::kMaxDecompressedBytes) {
       throw FormatError(path_, record.offset, "record of " + std::to_string(length) + " bytes does not fit in the file (a recording cut short?)");
     }
     file_record_.resize(length);
-    read_exactly(file_record_.data(), length, "a record");
+    file_.read_exactly(file_record_.data(), length, "a record");
     record.content = file_record_;
     record.in_chunk = false;
     if (record.opcode == kDataEnd || record.opcode == kFooter) {
@@ -227,17 +224,11 @@ class McapSource final : public PacketSource {
     chunk_offset_ = offset;
   }
 
-  void read_exactly(void* out, std::size_t size, const char* what) {
-    file_.read(static_cast<char*>(out), static_cast<std::streamsize>(size));
-    if (static_cast<std::size_t>(file_.gcount()) != size) {
-      throw FormatError(path_, position_ + static_cast<std::uint64_t>(file_.gcount()), std::string("file ends inside ") + what);
-    }
-    position_ += size;
-  }
 
-  std::string path_, wanted_;
-  std::ifstream file_;
-  std::uint64_t file_size_ = 0, position_ = 0;
+
+  detail::ContainerFile file_;
+  std::string path_;
+  std::string wanted_;
   bool at_end_ = false;
   std::vector<std::uint8_t> file_record_;
   std::vector<std::uint8_t> chunk_;
