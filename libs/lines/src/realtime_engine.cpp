@@ -59,32 +59,28 @@ void RealtimeEngine::process(const EventBatch& input) {
   }
   const EventBatch& batch = *stored;
   const std::size_t n = batch.size();
-  for (std::size_t begin = 0; begin < n; begin += kInsertChunk) {
+  // Chunks of the stored events; the last (or only, when the filters dropped all) also takes in the
+  // input's time, since events the filters dropped still move event time on.
+  std::size_t begin = 0;
+  do {
     const std::size_t end = std::min(n, begin + kInsertChunk);
-    const bool last = end == n;
     bool wake = false;
     {
       std::lock_guard lock(lattice_mutex_);
-      lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin));
-      events_stored_ += end - begin;
-      latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
-      if (last) note_input(input);
+      if (end > begin) {
+        lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin));
+        events_stored_ += end - begin;
+        latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
+      }
+      if (end == n) note_input(input);
       wake = latest_event_us_ >= std::min(detect_wake_at_us_, track_wake_at_us_);
     }
     if (wake) lattice_changed_.notify_all();
-  }
-  if (n > 0) return;
-  bool wake = false;
-  {
-    std::lock_guard lock(lattice_mutex_);
-    note_input(input);
-    wake = latest_event_us_ >= std::min(detect_wake_at_us_, track_wake_at_us_);
-  }
-  if (wake) lattice_changed_.notify_all();
+    begin = end;
+  } while (begin < n);
 }
 
 void RealtimeEngine::note_input(const EventBatch& input) {
-  // Events the filters dropped still move event time on, so rounds come due as they would without them.
   events_received_ += input.size();
   latest_event_us_ = std::max(latest_event_us_, input.t.back());
 }

@@ -11,8 +11,6 @@ namespace evldt {
 namespace {
 // A statistics message lists at most this many masked pixels (16 KiB), whatever a broken sensor does.
 constexpr std::size_t kMaxListedMaskedPixels = 4096;
-}  // namespace
-namespace {
 
 using Clock = std::chrono::steady_clock;
 
