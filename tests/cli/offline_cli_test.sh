@@ -74,6 +74,9 @@ awk -F, 'NR == 1 { print "t_us,id,x0,y0,x1,y1,score,status"; next } { print $1 "
 "$eval" --segments "$work/gt_as_pred.csv" --ground-truth "$work/rec/ground_truth.csv" --width 240 --height 180 \
   --json "$work/self.json" >"$work/self.txt"
 grep -Eq '^gt_as_pred.csv +- +1.000 +1.000 +1.000 +1.000 +1.000 +1.000' "$work/self.txt" || fail "self-evaluation: $(cat "$work/self.txt")"
+# Tracking: every line covered by its own id all its life, no switch, IDF1 1.
+tail -1 "$work/self.txt" | awk '{ exit !($(NF - 3) == "1.000" && $(NF - 2) == "1.0" && $(NF - 1) == 0 && $NF == "1.000") }' ||
+  fail "self-evaluation tracking: $(cat "$work/self.txt")"
 "$offline" "$work/rec/events.raw" -o "$work/p.csv" -q >/dev/null
 "$eval" --segments "$work/p.csv" --scene boxes-6dof --duration-s 0.4 | tail -1 | awk '{ $1 = ""; $2 = ""; print }' >"$work/from_file.txt"
 "$eval" --scene boxes-6dof --duration-s 0.4 --log-level warn --lifetime-png "$work/life.png" | tail -1 | awk '{ $1 = ""; $2 = ""; print }' >"$work/in_process.txt"

@@ -290,7 +290,10 @@ Segment moving_line(std::size_t step) { return row_segment(10 + 2 * static_cast<
 GroundTruthSteps moving_truth() {
   GroundTruthSteps steps;
   for (int k = 0; k < kGtSteps; ++k) steps.times.push_back(k * kGtPeriod);
-  steps.segments_at = [](std::size_t index, std::vector<Segment>& out) { out.assign(1, moving_line(index)); };
+  steps.segments_at = [](std::size_t index, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments.assign(1, moving_line(index));
+    ids.assign(1, 3);
+  };
   return steps;
 }
 

@@ -24,7 +24,7 @@ namespace {
 using namespace evldt;
 
 struct Options {
-  std::filesystem::path segments, ground_truth, json, pr_png, lifetime_png;
+  std::filesystem::path segments, ground_truth, json, pr_png, lifetime_png, tracks_png;
   std::string lcm_channel;
   std::vector<double> tolerances{0.01, 0.02};
   std::vector<float> pr_thresholds;
@@ -42,6 +42,7 @@ struct Report {
   StepCoverage coverage;
   Timestamp hold_us = 0;
   LifetimeSummary lifetime;
+  TrackingSummary tracking;
   std::uint64_t events = 0;
   double scene_seconds = 0, wall_seconds = 0;
 };
@@ -56,6 +57,7 @@ Report make_report(const StreamEvaluator& evaluator) {
   r.coverage = evaluator.coverage();
   r.hold_us = evaluator.hold_us();
   r.lifetime = evaluator.lifetimes().summary();
+  r.tracking = evaluator.tracking().summary();
   return r;
 }
 
@@ -123,12 +125,14 @@ StreamEvaluator evaluate_files(const Options& options, SensorSize sensor, const 
 }
 
 // An undefined ratio (nothing predicted, or no ground truth) is "n/a", never a perfect or zero score.
-std::string figure(double value) { return std::isfinite(value) ? fmt::format("{:.3f}", value) : "n/a"; }
+std::string figure(double value, int decimals = 3) {
+  return std::isfinite(value) ? fmt::format("{:.{}f}", value, decimals) : "n/a";
+}
 
 void print_table(const std::vector<Report>& reports, const Options& options) {
   std::printf("%-24s %6s", "run", "f_th");
   for (const double tol : options.tolerances) std::printf("   P@%.0f%%   R@%.0f%%   F@%.0f%%", tol * 100, tol * 100, tol * 100);
-  std::printf("  segs/step  gt/step  gt_steps  no_pred  ids  life_mean_ms life_max_ms\n");
+  std::printf("  segs/step  gt/step  gt_steps  no_pred  ids  life_mean_ms life_max_ms  cover  ids/gt  id_sw   IDF1\n");
   for (const Report& r : reports) {
     if (r.threshold) {
       std::printf("%-24s %6.3f", r.label.c_str(), static_cast<double>(*r.threshold));
@@ -136,10 +140,12 @@ void print_table(const std::vector<Report>& reports, const Options& options) {
       std::printf("%-24s %6s", r.label.c_str(), "-");
     }
     for (const Prf& p : r.summed) std::printf("  %6s  %6s  %6s", figure(p.precision).c_str(), figure(p.recall).c_str(), figure(p.f).c_str());
-    std::printf("  %9.1f  %7.1f  %8llu  %7llu  %4llu  %11.1f %11.1f\n", r.mean_predicted, r.mean_ground_truth,
-                static_cast<unsigned long long>(r.coverage.ground_truth_steps),
+    std::printf("  %9.1f  %7.1f  %8llu  %7llu  %4llu  %11.1f %11.1f  %5s  %6s  %5llu  %5s\n", r.mean_predicted,
+                r.mean_ground_truth, static_cast<unsigned long long>(r.coverage.ground_truth_steps),
                 static_cast<unsigned long long>(r.coverage.steps_without_prediction),
-                static_cast<unsigned long long>(r.lifetime.count), r.lifetime.mean_ms, r.lifetime.max_ms);
+                static_cast<unsigned long long>(r.lifetime.count), r.lifetime.mean_ms, r.lifetime.max_ms,
+                figure(r.tracking.coverage).c_str(), figure(r.tracking.ids_per_line, 1).c_str(),
+                static_cast<unsigned long long>(r.tracking.id_switches), figure(r.tracking.idf1).c_str());
   }
 }
 
@@ -172,12 +178,40 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
     json.key("mean_segments_per_step").value(r.mean_predicted).key("mean_gt_segments_per_step").value(r.mean_ground_truth);
     json.key("lifetime").begin_object().key("ids").value(r.lifetime.count).key("mean_ms").value(r.lifetime.mean_ms);
     json.key("std_ms").value(r.lifetime.std_ms).key("max_ms").value(r.lifetime.max_ms).end_object();
+    const TrackingSummary& t = r.tracking;
+    json.key("tracking").begin_object().key("tolerance").value(options.tolerances.front());
+    json.key("min_overlap").value(kDefaultMinOverlap).key("ground_truth_lines").value(t.ground_truth_lines);
+    json.key("lines_never_matched").value(t.lines_never_matched).key("coverage").value(t.coverage);
+    json.key("ids_per_line").value(t.ids_per_line).key("id_switches").value(t.id_switches);
+    json.key("id_precision").value(t.id_precision).key("id_recall").value(t.id_recall).key("idf1").value(t.idf1);
+    json.end_object();
     json.end_object();
   }
   json.end_array().end_object();
   if (!json.done()) throw std::logic_error("unbalanced JSON");
   out << "\n";
   if (!out) throw std::runtime_error("error writing " + options.json.string());
+}
+
+// With several runs (--pr-thresholds) each run's chart gets its own file: NAME-f<threshold>.png.
+std::filesystem::path run_path(const std::filesystem::path& path, const Report& report, bool several_runs) {
+  if (!several_runs || !report.threshold) return path;
+  std::filesystem::path result = path;
+  result.replace_filename(path.stem().string() + fmt::format("-f{:g}", static_cast<double>(*report.threshold)) +
+                          path.extension().string());
+  return result;
+}
+
+void write_run_plots(const Options& options, const StreamEvaluator& evaluator, const Report& report, bool several_runs) {
+  if (!options.lifetime_png.empty()) {
+    write_histogram_png(run_path(options.lifetime_png, report, several_runs),
+                        evaluator.lifetimes().histogram(options.histogram_bin_ms), options.histogram_bin_ms,
+                        report.label + " segment lifetimes");
+  }
+  if (!options.tracks_png.empty()) {
+    write_id_timeline_png(run_path(options.tracks_png, report, several_runs), evaluator.tracking().lines(),
+                          report.label + fmt::format(" ids over time (IDF1 {})", figure(report.tracking.idf1)));
+  }
 }
 
 int run(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim) {
@@ -196,6 +230,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     last.emplace(evaluate_files(options, *sensor, sim));
     reports.push_back(make_report(*last));
     reports.back().label = options.segments.filename().string();
+    write_run_plots(options, *last, reports.back(), false);
     const StepCoverage& c = last->coverage();
     spdlog::info("{} ground-truth steps scored, {} of them with no prediction within {:.1f} ms; {} predicted steps, {} "
                  "scored, {} outside the ground truth's time range (not scored)",
@@ -223,6 +258,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       r.scene_seconds = result.scene_seconds;
       r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, r.events, r.wall_seconds);
+      write_run_plots(options, *last, r, thresholds.size() > 1);
       reports.push_back(r);
     }
   }
@@ -234,10 +270,6 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     write_pr_curve_png(options.pr_png, points, reports.front().label + " PR over f_th (tolerance " +
                                                    std::to_string(options.tolerances[0] * 100).substr(0, 3) + "% of diagonal)");
   }
-  if (!options.lifetime_png.empty()) {
-    write_histogram_png(options.lifetime_png, last->lifetimes().histogram(options.histogram_bin_ms), options.histogram_bin_ms,
-                        reports.back().label + " segment lifetimes");
-  }
   return 0;
 }
 
@@ -248,7 +280,10 @@ int main(int argc, char** argv) {
                "image diagonal, counts summed over steps) and segment lifetimes. Either score a segment CSV\n"
                "against --ground-truth CSV or a --scene, or run the pipeline on --scene (with --pr-thresholds, once per f_th).\n"
                "Every ground-truth step is scored, against the latest predicted step at or before it within 1.5 output\n"
-               "periods, else against nothing (its ground truth counts as missed). Undefined figures print n/a."};
+               "periods, else against nothing (its ground truth counts as missed). Undefined figures print n/a.\n"
+               "Tracking, at the first tolerance: a predicted segment matches the true line within the tolerance of at\n"
+               "least half its length; cover = matched share of the true lines' steps, ids/gt = distinct ids per true\n"
+               "line, id_sw = changes of the id that stands for a line, IDF1 = identity F1 over lengths (one id per line)."};
   Options options;
   PipelineOptions pipeline_options;
   SimulatorOptions sim_options;
@@ -270,7 +305,10 @@ int main(int argc, char** argv) {
       ->check(finite_number() & CLI::Range(0.0, 1.0));
   app.add_option("--json", options.json, "Write the results as JSON");
   app.add_option("--pr-png", options.pr_png, "Plot precision/recall over the thresholds (first tolerance)");
-  app.add_option("--lifetime-png", options.lifetime_png, "Histogram of segment lifetimes");
+  app.add_option("--lifetime-png", options.lifetime_png,
+                 "Histogram of segment lifetimes (with --pr-thresholds one file per run, NAME-f<threshold>.png)");
+  app.add_option("--tracks-png", options.tracks_png,
+                 "Ids over time: a row per true line, coloured by the predicted id that stood for it (per run, as above)");
   app.add_option("--lifetime-bin-ms", options.histogram_bin_ms, "Histogram bin width")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.1, 1e6));

@@ -215,4 +215,90 @@ void write_histogram_png(const std::filesystem::path& path, const std::vector<st
   write_png(path, image);
 }
 
+void write_id_timeline_png(const std::filesystem::path& path, std::span<const GroundTruthLineTrack> lines,
+                           const std::string& title) {
+  std::vector<const GroundTruthLineTrack*> shown;
+  for (const GroundTruthLineTrack& line : lines) {
+    if (!line.owners.empty()) shown.push_back(&line);
+  }
+  if (shown.size() > kTimelineMaxLines) {
+    std::stable_sort(shown.begin(), shown.end(), [](const auto* a, const auto* b) { return a->visible_steps > b->visible_steps; });
+    shown.resize(kTimelineMaxLines);
+    std::stable_sort(shown.begin(), shown.end(), [](const auto* a, const auto* b) {
+      return a->owners.front().t_us < b->owners.front().t_us;
+    });
+  }
+  cv::Mat image = blank_chart(title);
+  const cv::Rect area(kMarginLeft, kMarginTop, kPlotWidth - kMarginLeft - kMarginRight,
+                      kPlotHeight - kMarginTop - kMarginBottom);
+  put_text(image,
+           formatted("%.0f", static_cast<double>(shown.size())) + " of " +
+               formatted("%.0f", static_cast<double>(lines.size())) +
+               " true lines; colour: predicted id, grey: none, tick: id switch",
+           kPlotWidth / 2, 52, kSmallText, kBlack, Align::Centre);
+  if (shown.empty()) {
+    put_text(image, "no data", area.x + area.width / 2, area.y + area.height / 2, kLabelText, kBlack, Align::Centre);
+    cv::rectangle(image, area, kBlack, 1);
+    write_png(path, image);
+    return;
+  }
+  Timestamp first = shown.front()->owners.front().t_us, last = first;
+  for (const auto* line : shown) {
+    first = std::min(first, line->owners.front().t_us);
+    last = std::max(last, line->owners.back().t_us);
+  }
+  const double seconds = std::max(1e-3, static_cast<double>(last - first) * 1e-6);
+  const double row_height = static_cast<double>(area.height) / static_cast<double>(shown.size());
+  const Axes axes{area, seconds, static_cast<double>(shown.size())};
+  const double x_step = nice_step(seconds, 10);
+  for (int k = 0; k <= static_cast<int>(std::floor(seconds / x_step + 1e-9)); ++k) {
+    const cv::Point bottom = axes.at(k * x_step, 0);
+    cv::line(image, bottom, axes.at(k * x_step, axes.y_max), kGrid, 1);
+    put_text(image, formatted("%g", k * x_step), bottom.x, bottom.y + 20, kSmallText, kBlack, Align::Centre);
+  }
+  put_text(image, "time [s]", area.x + area.width / 2, area.y + area.height + 48, kLabelText, kBlack, Align::Centre);
+  const auto x_of = [&](Timestamp t) { return axes.at(static_cast<double>(t - first) * 1e-6, 0).x; };
+  const auto colour_of = [](std::uint64_t id) {
+    // A fixed hue per id (Fibonacci hashing spreads consecutive ids), saturated and mid-bright.
+    const double hue = static_cast<double>((id * 0x9E3779B97F4A7C15ull) >> 40) / static_cast<double>(1ull << 24);
+    cv::Mat hsv(1, 1, CV_8UC3, cv::Scalar(hue * 180.0, 200, 210)), bgr;
+    cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+    const cv::Vec3b c = bgr.at<cv::Vec3b>(0, 0);
+    return cv::Scalar(c[0], c[1], c[2]);
+  };
+  const int label_every = static_cast<int>(std::ceil(14.0 / row_height));
+  for (std::size_t row = 0; row < shown.size(); ++row) {
+    const GroundTruthLineTrack& line = *shown[row];
+    const int top = area.y + static_cast<int>(std::lround(static_cast<double>(row) * row_height));
+    const int bottom = area.y + static_cast<int>(std::lround(static_cast<double>(row + 1) * row_height)) - 1;
+    const int inner_top = row_height >= 4 ? top + 1 : top;
+    for (std::size_t k = 0; k < line.owners.size(); ++k) {
+      const LineOwnerStep& o = line.owners[k];
+      // A step reaches to the next one of the line, or one spacing on at its end.
+      const Timestamp next = k + 1 < line.owners.size() ? line.owners[k + 1].t_us
+                             : k > 0                    ? o.t_us + (o.t_us - line.owners[k - 1].t_us)
+                                                        : o.t_us + 1;
+      const int x0 = x_of(o.t_us), x1 = std::max(x0 + 1, x_of(next));
+      cv::rectangle(image, cv::Rect(cv::Point(x0, inner_top), cv::Point(x1, bottom + 1)),
+                    o.matched ? colour_of(o.id) : kGrid, cv::FILLED);
+    }
+    std::uint64_t representative = 0;
+    bool has_representative = false;
+    for (const LineOwnerStep& o : line.owners) {
+      if (!o.matched) continue;
+      if (has_representative && o.id != representative) {
+        cv::line(image, {x_of(o.t_us), top}, {x_of(o.t_us), bottom}, kBlack, 1);
+      }
+      representative = o.id;
+      has_representative = true;
+    }
+    if (static_cast<int>(row) % label_every == 0) {
+      put_text(image, formatted("line %.0f", static_cast<double>(line.gt_id)), area.x - 6,
+               (top + bottom) / 2 + 4, kSmallText * 0.9, kBlack, Align::Right);
+    }
+  }
+  cv::rectangle(image, area, kBlack, 1);
+  write_png(path, image);
+}
+
 }  // namespace evldt

@@ -15,23 +15,36 @@ GroundTruthSteps scene_ground_truth_steps(const Scene& scene, Timestamp step_us)
   if (step_us <= 0) throw std::invalid_argument("ground-truth step must be positive");
   GroundTruthSteps steps;
   for (Timestamp t = 0; t <= scene.duration_us; t += step_us) steps.times.push_back(t);
-  steps.segments_at = [scene = std::make_shared<const Scene>(scene), times = steps.times](std::size_t index,
-                                                                                          std::vector<Segment>& out) {
-    out.clear();
-    for (const GtSegment& g : scene->visible_edges(times.at(index))) out.push_back({g.a.cast<float>(), g.b.cast<float>()});
+  steps.segments_at = [scene = std::make_shared<const Scene>(scene), times = steps.times](
+                          std::size_t index, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments.clear();
+    ids.clear();
+    for (const GtSegment& g : scene->visible_edges(times.at(index))) {
+      segments.push_back({g.a.cast<float>(), g.b.cast<float>()});
+      ids.push_back(static_cast<std::uint64_t>(g.gt_id));
+    }
   };
   return steps;
 }
 
 GroundTruthSteps csv_ground_truth_steps(const std::vector<GroundTruthRow>& rows) {
-  auto by_time = std::make_shared<std::map<Timestamp, std::vector<Segment>>>();
+  struct Step {
+    std::vector<Segment> segments;
+    std::vector<std::uint64_t> ids;
+  };
+  auto by_time = std::make_shared<std::map<Timestamp, Step>>();
   for (const GroundTruthRow& row : rows) {
-    (*by_time)[row.t_us].push_back({row.segment.a.cast<float>(), row.segment.b.cast<float>()});
+    Step& step = (*by_time)[row.t_us];
+    step.segments.push_back({row.segment.a.cast<float>(), row.segment.b.cast<float>()});
+    step.ids.push_back(static_cast<std::uint64_t>(row.segment.gt_id));
   }
   GroundTruthSteps steps;
-  for (const auto& [t, segments] : *by_time) steps.times.push_back(t);
-  steps.segments_at = [by_time, times = steps.times](std::size_t index, std::vector<Segment>& out) {
-    out = by_time->at(times.at(index));
+  for (const auto& entry : *by_time) steps.times.push_back(entry.first);
+  steps.segments_at = [by_time, times = steps.times](std::size_t index, std::vector<Segment>& segments,
+                                                     std::vector<std::uint64_t>& ids) {
+    const Step& step = by_time->at(times.at(index));
+    segments = step.segments;
+    ids = step.ids;
   };
   return steps;
 }
@@ -49,6 +62,7 @@ Timestamp median_step_spacing(std::span<const Timestamp> sorted_times) {
 StreamEvaluator::StreamEvaluator(SensorSize sensor, std::vector<double> tolerance_fractions,
                                  GroundTruthSteps ground_truth, Timestamp hold_us)
     : accuracy_(tolerance_fractions),
+      tracking_(tolerance_fractions.empty() ? 0.0 : diagonal_tolerance_px(sensor, tolerance_fractions.front())),
       ground_truth_(std::move(ground_truth)),
       hold_us_(hold_us),
       counts_(tolerance_fractions.size()) {
@@ -66,16 +80,20 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
   for (; next_step_ < times.size() && times[next_step_] < until; ++next_step_) {
     const bool use_held = holding_ && times[next_step_] - held_t_ <= hold_us_;
     const std::span<const Segment> predicted = use_held ? std::span<const Segment>(held_) : std::span<const Segment>();
+    const std::span<const std::uint64_t> predicted_ids =
+        use_held ? std::span<const std::uint64_t>(held_ids_) : std::span<const std::uint64_t>();
     held_scored_ = held_scored_ || use_held;
     coverage_.steps_without_prediction += use_held ? 0 : 1;
-    ground_truth_.segments_at(next_step_, truth_);
+    ground_truth_.segments_at(next_step_, truth_, truth_ids_);
     for (std::size_t i = 0; i < matchers_.size(); ++i) counts_[i] = matchers_[i].match(predicted, truth_);
     accuracy_.add_step(counts_, predicted.size(), truth_.size());
+    tracking_.add_step(times[next_step_], predicted_ids, predicted, truth_ids_, truth_);
   }
 }
 
 void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted) {
   if (finished_) throw std::logic_error("prediction added after finish()");
+  if (ids.size() != predicted.size()) throw std::invalid_argument("a predicted step needs one id per segment");
   if (holding_ && t < held_t_) throw std::invalid_argument("predicted steps must not go back in time");
   lifetimes_.observe_step(t, ids);
   if (!holding_ || t > held_t_) {
@@ -88,6 +106,7 @@ void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t>
   }
   holding_ = true;
   held_t_ = t;
+  held_ids_.assign(ids.begin(), ids.end());
   held_.assign(predicted.begin(), predicted.end());
 }
 

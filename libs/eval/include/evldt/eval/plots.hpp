@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "evldt/eval/tracking_metrics.hpp"
+
 namespace evldt {
 
 /// Size of every chart written here, in px.
@@ -32,5 +34,16 @@ void write_pr_curve_png(const std::filesystem::path& path, std::span<const PrPoi
 /// the path if the file cannot be written.
 void write_histogram_png(const std::filesystem::path& path, const std::vector<std::uint64_t>& counts,
                          double bin_width_ms, const std::string& title);
+
+/// Most true lines that write_id_timeline_png draws, one row each.
+inline constexpr std::size_t kTimelineMaxLines = 40;
+
+/// Ids over time: one row per true line (the kTimelineMaxLines seen longest, in order of first
+/// appearance), coloured at each step by the predicted id that stood for it (one colour per id, the
+/// same in every row), grey where none matched, with a black tick at each id switch. A line that one
+/// id follows for its whole life is one bar of one colour. Throws std::runtime_error naming the
+/// path if the file cannot be written.
+void write_id_timeline_png(const std::filesystem::path& path, std::span<const GroundTruthLineTrack> lines,
+                           const std::string& title);
 
 }  // namespace evldt

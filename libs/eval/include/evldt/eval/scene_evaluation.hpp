@@ -1,7 +1,7 @@
 #pragma once
 // Scoring a stream of predicted segments against ground truth over the ground truth's time range:
-// every ground-truth step is scored (heat-map counts at each tolerance), whatever the prediction
-// covers, and the lifetime of every predicted id is followed.
+// every ground-truth step is scored (heat-map counts at each tolerance, and the tracking metrics at the
+// first tolerance), whatever the prediction covers, and the lifetime of every predicted id is followed.
 
 #include <functional>
 #include <span>
@@ -9,6 +9,7 @@
 
 #include "evldt/eval/accumulator.hpp"
 #include "evldt/eval/line_heatmap.hpp"
+#include "evldt/eval/tracking_metrics.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
@@ -18,8 +19,9 @@ namespace evldt {
 /// The times at which ground truth is known, and its segments at each.
 struct GroundTruthSteps {
   std::vector<Timestamp> times;  ///< strictly increasing
-  /// Fills `out` with the segments of step `index` (an index into `times`).
-  std::function<void(std::size_t index, std::vector<Segment>& out)> segments_at;
+  /// Fills `segments` with the visible line pieces of step `index` (an index into `times`) and `ids`
+  /// with the id of the true line of each (pieces of one line share its id).
+  std::function<void(std::size_t index, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids)> segments_at;
 };
 
 /// A scene's exact visible edges at t = 0, step_us, 2 step_us, ... up to its duration (the steps
@@ -58,6 +60,8 @@ class StreamEvaluator {
 
   [[nodiscard]] const EvaluationAccumulator& accuracy() const { return accuracy_; }
   [[nodiscard]] const LifetimeTracker& lifetimes() const { return lifetimes_; }
+  /// Tracking metrics, at the first tolerance.
+  [[nodiscard]] const TrackingEvaluator& tracking() const { return tracking_; }
   [[nodiscard]] const StepCoverage& coverage() const { return coverage_; }
   [[nodiscard]] Timestamp hold_us() const { return hold_us_; }
   [[nodiscard]] const GroundTruthSteps& ground_truth() const { return ground_truth_; }
@@ -69,13 +73,16 @@ class StreamEvaluator {
   std::vector<HeatmapMatcher> matchers_;
   EvaluationAccumulator accuracy_;
   LifetimeTracker lifetimes_;
+  TrackingEvaluator tracking_;
   GroundTruthSteps ground_truth_;
   Timestamp hold_us_;
   std::size_t next_step_ = 0;
   bool holding_ = false;
   bool held_scored_ = false;
   Timestamp held_t_ = 0;
+  std::vector<std::uint64_t> held_ids_;
   std::vector<Segment> held_;
+  std::vector<std::uint64_t> truth_ids_;
   std::vector<Segment> truth_;
   std::vector<MatchCounts> counts_;
   StepCoverage coverage_;

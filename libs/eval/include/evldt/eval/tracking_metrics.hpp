@@ -1,0 +1,116 @@
+#pragma once
+// Tracking metrics for line segments, after CLEAR-MOT and IDF1, with ground-truth lines as the
+// objects and predicted ids as the hypotheses. A predicted segment matches a true line at a step when
+// at least min_overlap of its length lies within the tolerance of that line's visible pieces (of
+// several such lines, the one covering most of it). Lengths are sampled every kOverlapSamplePx.
+
+#include <cstdint>
+#include <span>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "evldt/events/event.hpp"
+#include "evldt/lines/geometry.hpp"
+
+namespace evldt {
+
+/// Largest distance between the samples that measure how much of a segment lies near a line, in px.
+inline constexpr double kOverlapSamplePx = 1.0;
+/// The share of a predicted segment's length that must lie within the tolerance of a true line.
+inline constexpr double kDefaultMinOverlap = 0.5;
+
+/// Which predicted id stood for a true line at one step (matched = false: none matched it).
+struct LineOwnerStep {
+  Timestamp t_us = 0;
+  bool matched = false;
+  std::uint64_t id = 0;
+};
+
+/// One ground-truth line over the run.
+struct GroundTruthLineTrack {
+  std::uint64_t gt_id = 0;
+  std::uint64_t visible_steps = 0;
+  std::uint64_t matched_steps = 0;  ///< steps at which at least one predicted segment matched it
+  std::uint64_t distinct_ids = 0;   ///< predicted ids that matched it at some step (fragmentation)
+  std::uint64_t id_switches = 0;    ///< times its representative id changed
+  /// Every visible step. The representative is the id that represented it before if that id still
+  /// matches, else the matching id covering most of it (ties: the lower id), as CLEAR-MOT keeps a
+  /// correspondence while it holds. A step that nothing matches leaves the representative as it was.
+  std::vector<LineOwnerStep> owners;
+};
+
+struct TrackingSummary {
+  std::uint64_t ground_truth_lines = 0;
+  std::uint64_t lines_never_matched = 0;
+  /// Matched line-steps over visible line-steps: how much of the true lines' lives is covered.
+  double coverage = 0;
+  /// Mean distinct ids per line over the lines matched at least once (1 = one id for a line's life).
+  double ids_per_line = 0;
+  std::uint64_t id_switches = 0;
+  /// IDF1 over lengths: the global one-to-one assignment of predicted ids to true lines that
+  /// maximises the matched length summed over steps (id_true_positive_px); id precision divides it
+  /// by all predicted length, id recall by all true length. NaN where a denominator is 0.
+  double id_precision = 0;
+  double id_recall = 0;
+  double idf1 = 0;
+  double id_true_positive_px = 0;
+  double predicted_px = 0;
+  double ground_truth_px = 0;
+};
+
+class TrackingEvaluator {
+ public:
+  /// Throws std::invalid_argument unless tolerance_px >= 0 and min_overlap is in (0, 1].
+  explicit TrackingEvaluator(double tolerance_px, double min_overlap = kDefaultMinOverlap);
+
+  /// One step: the prediction in force and the true lines' visible pieces (several pieces may share a
+  /// line id). Each id span must be as long as its segment span (else std::invalid_argument). Steps
+  /// must come in time order.
+  void add_step(Timestamp t, std::span<const std::uint64_t> predicted_ids, std::span<const Segment> predicted,
+                std::span<const std::uint64_t> truth_ids, std::span<const Segment> truth);
+
+  /// Solves the id assignment over everything added so far.
+  [[nodiscard]] TrackingSummary summary() const;
+  /// One entry per true line seen, in order of first appearance.
+  [[nodiscard]] const std::vector<GroundTruthLineTrack>& lines() const { return lines_; }
+  [[nodiscard]] double tolerance_px() const { return tolerance_px_; }
+  [[nodiscard]] double min_overlap() const { return min_overlap_; }
+
+ private:
+  struct Match {
+    std::size_t line = 0;
+    std::uint64_t id = 0;
+    double overlap_px = 0;
+  };
+  /// The length of `segment` within the tolerance of each line, into overlap_by_line_ (indexed like
+  /// step_lines_), and the segment's length.
+  double measure_overlaps(const Segment& segment, std::span<const Segment> truth);
+  std::size_t line_index(std::uint64_t gt_id);
+  std::size_t predicted_index(std::uint64_t id);
+
+  double tolerance_px_;
+  double min_overlap_;
+  std::vector<GroundTruthLineTrack> lines_;
+  std::vector<std::unordered_set<std::uint64_t>> ids_of_line_;
+  std::vector<LineOwnerStep> last_owner_;  ///< per line: its representative when last matched
+  std::unordered_map<std::uint64_t, std::size_t> line_of_gt_id_;
+  std::unordered_map<std::uint64_t, std::size_t> index_of_predicted_id_;
+  /// Matched length summed over steps per (predicted index, line index), key = predicted << 32 | line.
+  std::unordered_map<std::uint64_t, double> pair_overlap_px_;
+  double predicted_px_ = 0;
+  double ground_truth_px_ = 0;
+
+  // Per-step scratch.
+  std::vector<std::size_t> line_of_piece_;  ///< index into lines_ of each truth piece
+  std::vector<std::size_t> step_lines_;     ///< distinct lines of this step
+  std::vector<std::size_t> slot_of_line_;   ///< position in step_lines_ of each line seen (or npos)
+  std::vector<double> overlap_by_line_;
+  std::vector<std::size_t> hit_stamp_;      ///< per step line: the last sample that counted for it
+  std::vector<std::size_t> candidates_;     ///< truth pieces near the segment being measured
+  std::vector<Match> matches_;
+  bool stepped_ = false;
+  Timestamp last_t_ = 0;
+};
+
+}  // namespace evldt
