@@ -46,6 +46,46 @@ TEST(EndpointMotion, SlidesAlongItsBorder) {
   EXPECT_EQ(m.step, Point2(0, 0.8f));
 }
 
+TEST(LineMap, ANewLineAlongOneJustReleasedTakesOverItsId) {
+  LineMap lines(kGeometry);  // default reassociation: 100 ms, 10 degrees, 0.5 b = 4 px
+  const int a = kGeometry.index(1, 1), b = kGeometry.index(2, 1);
+  const auto id = lines.add({Point2(12, 14), Point2(20, 15)}, 0.5f, a, 1000);
+  lines.lines()[0].last_good_us = 5000;
+  lines.release(0, ReleaseReason::TooFewPoints);
+  EXPECT_EQ(lines.released_lifetimes().count, 1u);
+  // In the next block, 2 px off the released line's extension and 5 degrees from it.
+  const auto again = lines.add({Point2(20, 17), Point2(28, 17.7f)}, 0.5f, b, 90'000);
+  EXPECT_EQ(again, id);
+  EXPECT_EQ(lines.lines()[0].first_seen_us, 1000);
+  EXPECT_EQ(lines.reassociated(), 1u);
+  EXPECT_EQ(lines.created(), 1u);
+  EXPECT_EQ(lines.released_lifetimes().count, 0u);  // the id lives on: its lifetime is not over
+  // The remembered line is taken: another line there gets a new id.
+  EXPECT_NE(lines.add({Point2(12, 14), Point2(20, 15)}, 0.5f, a, 90'000), id);
+}
+
+TEST(LineMap, NoIdIsTakenOverAcrossTimeAngleOrOffset) {
+  const int a = kGeometry.index(1, 1), b = kGeometry.index(2, 1);
+  const Segment released = {Point2(12, 14), Point2(20, 14)};
+  const auto new_id_for = [&](const Segment& next, Timestamp at, ReassociationParams params) {
+    LineMap lines(kGeometry, params);
+    const auto id = lines.add(released, 0.5f, a, 0);
+    lines.release(0, ReleaseReason::BadTracks);
+    return lines.add(next, 0.5f, b, at) != id;
+  };
+  const ReassociationParams defaults;
+  EXPECT_FALSE(new_id_for({Point2(20, 15), Point2(28, 15)}, 100'000, defaults));
+  EXPECT_TRUE(new_id_for({Point2(20, 15), Point2(28, 15)}, 100'001, defaults));        // after the window
+  EXPECT_TRUE(new_id_for({Point2(20, 14), Point2(28, 16)}, 50'000, defaults));         // 14 degrees off
+  EXPECT_TRUE(new_id_for({Point2(20, 18.5f), Point2(28, 18.5f)}, 50'000, defaults));  // 4.5 px off
+  EXPECT_TRUE(new_id_for({Point2(20, 15), Point2(28, 15)}, 50'000, {.window_us = 0}));  // switched off
+  // Not a neighbour of the block it was released from.
+  LineMap lines(kGeometry);
+  const auto id = lines.add(released, 0.5f, a, 0);
+  lines.release(0, ReleaseReason::BadTracks);
+  EXPECT_NE(lines.add({Point2(28, 14), Point2(36, 14)}, 0.5f, kGeometry.index(3, 1), 10), id);
+}
+
 TEST(LineMap, OwnershipFollowsTheLineCentre) {
   LineMap lines(kGeometry);
   const int a = kGeometry.index(1, 1), b = kGeometry.index(2, 1);
@@ -103,7 +143,7 @@ TEST(LineMap, SuppressionProhibitsNearNeighboursForOneDetectionRound) {
   EXPECT_NEAR(found.segment.q1.x(), 15.5f, 1e-3f);
 }
 
-TEST(LineTracker, ReleasesAfterMaxBadTracksAndWhenPointsVanish) {
+TEST(LineTracker, ReleasesAfterItsPatienceAndWhenPointsVanish) {
   ScarfLattice lattice({64, 48}, 8, 1.0);
   for (int y = 20; y < 28; ++y) lattice.insert(15, static_cast<std::uint16_t>(y));  // 8 points: score 0.25
   LineMap lines(kGeometry);
@@ -111,13 +151,14 @@ TEST(LineTracker, ReleasesAfterMaxBadTracksAndWhenPointsVanish) {
   score.fit_threshold = 0.3f;  // the line can never score above this
   TrackParams track;
   track.perturbation_px = 0.8f;
-  track.max_bad_tracks = 2;
+  track.bad_track_patience_us = 5;
   LineTracker tracker(kGeometry, score, track);
   lines.add({Point2(15.5f, 20), Point2(15.5f, 28)}, 0.25f, kGeometry.index(1, 2), 0);
   tracker.track(lattice, lines, 1);
+  tracker.track(lattice, lines, 4);  // rounds do not count, event time does
   ASSERT_EQ(lines.lines().size(), 1u);
   EXPECT_EQ(lines.lines()[0].status, LineStatus::BadTrack);
-  tracker.track(lattice, lines, 2);
+  tracker.track(lattice, lines, 5);
   EXPECT_TRUE(lines.lines().empty());
   EXPECT_EQ(lines.released(ReleaseReason::BadTracks), 1u);
 

@@ -37,8 +37,17 @@ void PipelineOptions::add_to(CLI::App& app) {
       ->check(CLI::Range(0, 20));
   group->add_option("--perturbation", perturbation_, "Endpoint perturbation dq in pixels")
       ->check(finite_number() & CLI::Range(0.01, 20.0));
-  group->add_option("--max-bad-tracks", max_bad_tracks_, "Consecutive bad tracking rounds before a line is released")
-      ->check(CLI::Range(1, 1000));
+  group->add_option("--bad-track-patience-us", bad_track_patience_,
+                    "Event time a line may go without a good track before it is released")
+      ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
+  group->add_option("--reassociation-window-us", reassociation_window_,
+                    "A new line takes over the id of a line released nearby within this event time (0: never)")
+      ->check(CLI::Range(Timestamp{0}, Timestamp{10'000'000}));
+  group->add_option("--reassociation-max-angle", reassociation_angle_, "... if their directions differ by at most this (degrees)")
+      ->check(finite_number() & CLI::Range(0.0, 90.0));
+  group->add_option("--reassociation-max-offset", reassociation_offset_,
+                    "... and its centre lies within this fraction of b from the released line")
+      ->check(finite_number() & CLI::Range(0.0, 4.0));
   group->add_option("--multi-block-norm", multi_block_norm_, "r_e divisor for lines over k blocks: block (N) or union (k*N)")
       ->check(CLI::IsMember({"block", "union"}));
   group->add_option("--track-period-us", track_period_, "Deterministic mode: tracking period in event time")
@@ -85,7 +94,10 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   if (inlier_ratio_) config.score.inlier_distance_ratio = *inlier_ratio_;
   if (fit_iterations_) config.score.fit_iterations = *fit_iterations_;
   if (perturbation_) config.track.perturbation_px = *perturbation_;
-  if (max_bad_tracks_) config.track.max_bad_tracks = *max_bad_tracks_;
+  if (bad_track_patience_) config.track.bad_track_patience_us = *bad_track_patience_;
+  if (reassociation_window_) config.track.reassociation.window_us = *reassociation_window_;
+  if (reassociation_angle_) config.track.reassociation.max_angle_deg = *reassociation_angle_;
+  if (reassociation_offset_) config.track.reassociation.max_offset_ratio = *reassociation_offset_;
   if (multi_block_norm_) {
     config.track.multi_block_norm = *multi_block_norm_ == "union" ? EffectiveRatioNorm::Union : EffectiveRatioNorm::Block;
   }

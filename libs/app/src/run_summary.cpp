@@ -33,6 +33,7 @@ void RunSummary::add_pipeline(const DeterministicPipeline& pipeline) {
   counters = pipeline.counters();
   const LineMap& lines = pipeline.lines();
   lines_created = lines.created();
+  lines_reassociated = lines.reassociated();
   lines_alive = lines.lines().size();
   for (int r = 0; r < kReleaseReasonCount; ++r) released[r] = lines.released(static_cast<ReleaseReason>(r));
   lifetimes = lines.released_lifetimes();
@@ -64,7 +65,8 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
                "  rounds           %" PRIu64 " tracking, %" PRIu64 " detection, %" PRIu64 " skipped over gaps, %" PRIu64
                " schedule restarts (clock went back)\n",
                counters.track_rounds, counters.detect_rounds, counters.skipped_rounds, counters.clock_restarts);
-  std::fprintf(out, "  lines            %" PRIu64 " created, %" PRIu64 " alive at the end\n", lines_created, lines_alive);
+  std::fprintf(out, "  lines            %" PRIu64 " created, %" PRIu64 " detections took over a released line's id, %" PRIu64
+               " alive at the end\n", lines_created, lines_reassociated, lines_alive);
   std::fprintf(out, "  released         ");
   for (int r = 0; r < kReleaseReasonCount; ++r) {
     std::fprintf(out, "%s%s %" PRIu64, r ? ", " : "", reason_name(static_cast<ReleaseReason>(r)).data(), released[r]);
@@ -93,7 +95,8 @@ void RunSummary::write_json(const std::filesystem::path& path) const {
   out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds << ",\n";
   out << "  \"skipped_rounds\": " << counters.skipped_rounds << ",\n";
   out << "  \"clock_restarts\": " << counters.clock_restarts << ",\n";
-  out << "  \"lines_created\": " << lines_created << ",\n  \"lines_alive\": " << lines_alive << ",\n  \"released\": {";
+  out << "  \"lines_created\": " << lines_created << ",\n  \"lines_reassociated\": " << lines_reassociated
+      << ",\n  \"lines_alive\": " << lines_alive << ",\n  \"released\": {";
   for (int r = 0; r < kReleaseReasonCount; ++r) {
     out << (r ? ", " : "") << '"' << reason_name(static_cast<ReleaseReason>(r)) << "\": " << released[r];
   }

@@ -10,7 +10,7 @@ DeterministicPipeline::DeterministicPipeline(const PipelineConfig& config, bool 
     : config_(config),
       filters_(config.filters, config.lattice.sensor),
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha, keep_surface),
-      lines_(lattice_.geometry()),
+      lines_(lattice_.geometry(), config.track.reassociation),
       detector_(lattice_.geometry(), config.score),
       tracker_(lattice_.geometry(), config.score, config.track) {
   if (config.schedule.track_period_us <= 0 || config.schedule.detect_period_us <= 0) {

@@ -1,6 +1,8 @@
 #include "evldt/lines/line_map.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace evldt {
@@ -25,8 +27,11 @@ std::string_view reason_name(ReleaseReason reason) {
   return "?";
 }
 
-LineMap::LineMap(const LatticeGeometry& geometry)
+LineMap::LineMap(const LatticeGeometry& geometry, const ReassociationParams& reassociation)
     : geometry_(geometry),
+      reassociation_(reassociation),
+      min_cos_angle_(std::cos(reassociation.max_angle_deg * std::numbers::pi_v<float> / 180.0f)),
+      released_by_block_(static_cast<std::size_t>(geometry.block_count())),
       status_(static_cast<std::size_t>(geometry.block_count()), BlockStatus::NoDetect),
       owner_(static_cast<std::size_t>(geometry.block_count()), -1) {
   lines_.reserve(static_cast<std::size_t>(geometry.block_count()));  // at most one line per block
@@ -42,21 +47,58 @@ void LineMap::set_block_status(int block, BlockStatus status) {
 std::uint64_t LineMap::add(const Segment& segment, float score, int admin_block, Timestamp now) {
   if (status_[admin_block] == BlockStatus::Owned) throw std::logic_error("a block administers at most one line");
   TrackedLine line;
-  line.id = next_id_++;
   line.segment = segment;
   line.score = score;
   line.admin_block = admin_block;
   line.first_seen_us = now;
   line.last_good_us = now;
+  if (ReleasedLine* earlier = find_released(segment, admin_block, now)) {
+    line.id = earlier->id;
+    line.first_seen_us = earlier->first_seen_us;
+    released_lifetimes_.take_back(earlier->last_good_us - earlier->first_seen_us);
+    earlier->present = false;
+    ++reassociated_;
+  } else {
+    line.id = next_id_++;
+  }
   status_[admin_block] = BlockStatus::Owned;
   owner_[admin_block] = static_cast<std::int32_t>(lines_.size());
   lines_.push_back(line);
   return line.id;
 }
 
+LineMap::ReleasedLine* LineMap::find_released(const Segment& segment, int block, Timestamp now) {
+  if (reassociation_.window_us <= 0) return nullptr;
+  const float length = segment.length();
+  if (!(length > 0)) return nullptr;
+  const Point2 direction = (segment.q1 - segment.q0) / length;
+  const Point2 centre = segment.centre();
+  const float max_offset = reassociation_.max_offset_ratio * static_cast<float>(geometry_.block_size);
+  ReleasedLine* best = nullptr;
+  float best_offset = 0;
+  const int i = geometry_.column(block), j = geometry_.row(block);
+  for (int nj = std::max(0, j - 1); nj <= std::min(geometry_.blocks_y - 1, j + 1); ++nj) {
+    for (int ni = std::max(0, i - 1); ni <= std::min(geometry_.blocks_x - 1, i + 1); ++ni) {
+      ReleasedLine& candidate = released_by_block_[static_cast<std::size_t>(geometry_.index(ni, nj))];
+      if (!candidate.present || now - candidate.last_good_us > reassociation_.window_us) continue;
+      const Point2 along = candidate.segment.q1 - candidate.segment.q0;
+      const float candidate_length = along.norm();
+      if (!(candidate_length > 0)) continue;
+      if (std::abs(direction.dot(along)) < min_cos_angle_ * candidate_length) continue;
+      const float offset = std::abs(cross2(along, centre - candidate.segment.q0)) / candidate_length;
+      if (offset > max_offset || (best != nullptr && offset >= best_offset)) continue;
+      best = &candidate;
+      best_offset = offset;
+    }
+  }
+  return best;
+}
+
 void LineMap::release(std::size_t index, ReleaseReason reason) {
   const int block = lines_[index].admin_block;
-  released_lifetimes_.add(lines_[index].last_good_us - lines_[index].first_seen_us);
+  const TrackedLine& gone = lines_[index];
+  released_lifetimes_.add(gone.last_good_us - gone.first_seen_us);
+  released_by_block_[static_cast<std::size_t>(block)] = {true, gone.id, gone.segment, gone.first_seen_us, gone.last_good_us};
   status_[block] = BlockStatus::NoDetect;
   owner_[block] = -1;
   if (index + 1 != lines_.size()) {
@@ -131,6 +173,7 @@ void LineMap::set_first_id(std::uint64_t first) {
 void LineMap::clear() {
   std::fill(status_.begin(), status_.end(), BlockStatus::NoDetect);
   std::fill(owner_.begin(), owner_.end(), -1);
+  std::fill(released_by_block_.begin(), released_by_block_.end(), ReleasedLine{});
   lines_.clear();
 }
 

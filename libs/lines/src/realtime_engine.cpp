@@ -17,7 +17,7 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
       detect_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
       track_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
-      lines_(lattice_.geometry()),
+      lines_(lattice_.geometry(), config.track.reassociation),
       detector_(lattice_.geometry(), config.score),
       tracker_(lattice_.geometry(), config.score, config.track) {}
 

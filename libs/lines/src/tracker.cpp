@@ -140,11 +140,10 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Tim
   if (line.score > score_params_.fit_threshold) {
     line.status = LineStatus::GoodTrack;
     line.last_good_us = now;
-    line.bad_tracks = 0;
     return true;
   }
   line.status = LineStatus::BadTrack;
-  if (++line.bad_tracks >= params_.max_bad_tracks) {
+  if (now - line.last_good_us >= params_.bad_track_patience_us) {
     reason = ReleaseReason::BadTracks;
     return false;
   }

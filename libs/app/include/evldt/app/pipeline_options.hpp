@@ -24,11 +24,11 @@ class PipelineOptions {
   [[nodiscard]] Timestamp time_slack_us() const { return time_slack_us_; }
 
  private:
-  std::optional<int> width_, height_, block_size_, fit_iterations_, max_bad_tracks_;
+  std::optional<int> width_, height_, block_size_, fit_iterations_;
   std::optional<double> alpha_;
-  std::optional<float> fit_threshold_, inlier_ratio_, perturbation_;
+  std::optional<float> fit_threshold_, inlier_ratio_, perturbation_, reassociation_angle_, reassociation_offset_;
   std::optional<std::string> multi_block_norm_;
-  std::optional<Timestamp> track_period_, detect_period_;
+  std::optional<Timestamp> track_period_, detect_period_, bad_track_patience_, reassociation_window_;
   std::optional<std::string> filters_;
   std::optional<Timestamp> ba_window_, filter_refractory_, hot_window_;
   std::optional<double> ba_min_noise_hz_, hot_rate_, hot_ratio_, flicker_min_hz_, flicker_max_hz_;

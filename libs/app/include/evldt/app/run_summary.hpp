@@ -22,7 +22,8 @@ struct RunSummary {
   double event_seconds = 0;
   double wall_seconds = 0;
   PipelineCounters counters;
-  std::uint64_t lines_created = 0;
+  std::uint64_t lines_created = 0;       ///< distinct ids
+  std::uint64_t lines_reassociated = 0;  ///< detections that took over a released line's id
   std::uint64_t lines_alive = 0;
   std::uint64_t released[kReleaseReasonCount] = {};
   LifetimeStats lifetimes;  ///< released and live lines

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "evldt/lines/geometry.hpp"
+#include "evldt/lines/params.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"
 
 namespace evldt {
@@ -28,7 +29,6 @@ struct TrackedLine {
   int admin_block = -1;
   Timestamp first_seen_us = 0;
   Timestamp last_good_us = 0;  ///< last time its score was above threshold (detection counts)
-  int bad_tracks = 0;          ///< consecutive BadTrack rounds
 };
 
 /// Why a line ended; the pipeline's statistics count each.
@@ -46,19 +46,28 @@ struct LifetimeStats {
     sum_us += static_cast<double>(lifetime_us);
     if (lifetime_us > max_us) max_us = lifetime_us;
   }
+  /// Takes back an add() whose line lives on under a new one (its lifetime will be longer, so the
+  /// maximum stays right).
+  void take_back(Timestamp lifetime_us) {
+    --count;
+    sum_us -= static_cast<double>(lifetime_us);
+  }
   [[nodiscard]] double mean_us() const { return count ? sum_us / static_cast<double>(count) : 0.0; }
 };
 
 class LineMap {
  public:
-  explicit LineMap(const LatticeGeometry& geometry);
+  explicit LineMap(const LatticeGeometry& geometry, const ReassociationParams& reassociation = {});
 
   [[nodiscard]] const std::vector<TrackedLine>& lines() const { return lines_; }
   [[nodiscard]] std::vector<TrackedLine>& lines() { return lines_; }
   [[nodiscard]] BlockStatus block_status(int block) const { return status_[block]; }
   void set_block_status(int block, BlockStatus status);
 
-  /// Creates a line administered by a free block; returns its id.
+  /// Creates a line administered by a free block; returns its id. The line takes over the id and
+  /// first-seen time of a line released from this block or a neighbour within the reassociation
+  /// window when it lies along it (angle and offset within bounds; of several, the nearest),
+  /// else it gets a new id.
   std::uint64_t add(const Segment& segment, float score, int admin_block, Timestamp now);
   /// Removes the line at `index` (swap-remove: the last line takes its place) and frees its block.
   void release(std::size_t index, ReleaseReason reason);
@@ -72,15 +81,31 @@ class LineMap {
   /// Lifetimes of the lines released so far (add the live ones for a run's total).
   [[nodiscard]] const LifetimeStats& released_lifetimes() const { return released_lifetimes_; }
   [[nodiscard]] std::uint64_t created() const { return next_id_ - first_id_; }
+  /// Lines that took over a released line's id.
+  [[nodiscard]] std::uint64_t reassociated() const { return reassociated_; }
   /// Ids start here; a per-process epoch can be folded in by the caller (services restart).
   void set_first_id(std::uint64_t first);
   void clear();
 
  private:
+  /// A line released a moment ago, remembered by the block that administered it.
+  struct ReleasedLine {
+    bool present = false;
+    std::uint64_t id = 0;
+    Segment segment;
+    Timestamp first_seen_us = 0;
+    Timestamp last_good_us = 0;
+  };
   void transfer_ownership();
   void suppress_detection(float suppress_ratio);
+  /// The remembered line a new segment in `block` continues, or nullptr.
+  ReleasedLine* find_released(const Segment& segment, int block, Timestamp now);
 
   LatticeGeometry geometry_;
+  ReassociationParams reassociation_;
+  float min_cos_angle_ = 1;
+  std::vector<ReleasedLine> released_by_block_;  ///< per block: the last line released from it
+  std::uint64_t reassociated_ = 0;
   std::vector<BlockStatus> status_;
   std::vector<std::int32_t> owner_;  ///< per block: index into lines_ of the line it administers, or -1
   std::vector<TrackedLine> lines_;

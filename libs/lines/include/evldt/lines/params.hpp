@@ -26,10 +26,20 @@ struct ScoreParams {
   int fit_iterations = 3;              ///< robust (Fair-weighted) reweighting rounds after the first PCA fit
 };
 
+/// A new detection takes over the id of a line released nearby a moment before, so an id lasts
+/// through a short loss of its edge and through ownership hand-over (DESIGN 8: tracks that last).
+struct ReassociationParams {
+  Timestamp window_us = 100'000;  ///< since the released line's last good track; 0: never
+  float max_angle_deg = 10.0f;
+  float max_offset_ratio = 0.5f;  ///< of b: the new segment's centre from the released line
+};
+
 struct TrackParams {
   float perturbation_px = 2.5f;  ///< dq
-  int max_bad_tracks = 10;       ///< consecutive BadTrack rounds before a line is released (chosen by the accuracy benchmark)
+  /// Event time a line may go without a good track before it is released (chosen on the 10 s scenes).
+  Timestamp bad_track_patience_us = 80'000;
   EffectiveRatioNorm multi_block_norm = EffectiveRatioNorm::Block;
+  ReassociationParams reassociation;
 };
 
 struct ScheduleParams {
