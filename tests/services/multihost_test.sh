@@ -56,7 +56,7 @@ check "ttl=0 traffic of host 2 does not reach host 3" test "$(grep -c '^invalid 
 
 "${h3[@]}" "$probe" "$url" cam0 600 >"$work/probe.out" &
 probe_pid=$!
-"${h3[@]}" lcm-logger --lcm-url="$url" -f -q "$work/far.lcm" &
+"${h3[@]}" lcm-logger --lcm-url="$url&recv_buf_size=8388608" -f -q "$work/far.lcm" &  # as the services ask
 logger_pid=$!
 "${h3[@]}" "$viz" --lcm-url "$url" --headless --png-dir "$work/png" --png-period-s 0.5 >"$work/viz.out" 2>"$work/viz.err" &
 viz_pid=$!

@@ -13,7 +13,9 @@ replay_url="udpm://239.255.76.67:7712?ttl=0"
 scene=(--scene boxes-6dof --duration-s 1.5)
 
 # --- live run ---------------------------------------------------------------------------------
-lcm-logger --lcm-url="$url" -f -q "$work/live.lcm" &
+# The logger gets the 8 MiB receive buffer the services ask for: with the default (208 KiB) it loses
+# batches whenever both cores are busy for a moment.
+lcm-logger --lcm-url="$url&recv_buf_size=8388608" -f -q "$work/live.lcm" &
 logger_pid=$!
 "$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines.out" 2>"$work/lines.err" &
 lines_pid=$!
@@ -61,7 +63,7 @@ check "live F@1% within 0.06 of offline" close_to "$live_f" "$offline_f" 0.06
 check "live F@1% >= 0.75" close_to "$live_f" 0.875 0.125
 
 # --- replay: lcm-logplayer feeds the recorded events to a fresh lines service ------------------
-lcm-logger --lcm-url="$replay_url" -f -q --channel='LINES_.*|TEST_MARKER' "$work/replay.lcm" &
+lcm-logger --lcm-url="$replay_url&recv_buf_size=8388608" -f -q --channel='LINES_.*|TEST_MARKER' "$work/replay.lcm" &
 replay_logger_pid=$!
 "$lines" --lcm-url "$replay_url" --log-period-s 0 >"$work/replay_lines.out" 2>"$work/replay_lines.err" &
 replay_lines_pid=$!
