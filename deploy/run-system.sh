@@ -40,13 +40,14 @@ stop_all() {
 }
 trap 'stop_all; exit 130' INT TERM
 
-# The logger needs the receive buffer the services ask for, or it loses bursts of batches.
+# The logger needs the receive buffer the services ask for, and a higher priority where allowed: the
+# stock lcm-logger keeps only 30 messages per subscription while it waits for a core.
 logger_url=$LCM_DEFAULT_URL
 if [[ $logger_url == udpm://* && $logger_url != *recv_buf_size* ]]; then
   [[ $logger_url == *\?* ]] && logger_url+="&" || logger_url+="?"
   logger_url+="recv_buf_size=8388608"
 fi
-lcm-logger --lcm-url="$logger_url" -f -q "$out/run.lcmlog" &
+nice -n -10 lcm-logger --lcm-url="$logger_url" -f -q "$out/run.lcmlog" &
 pids+=($!)
 "$bin/services/evldt-lines/evldt-lines" --camera "$camera_name" >"$out/lines.txt" 2>"$out/lines.log" &
 pids+=($!)

@@ -58,9 +58,10 @@ check "the restarted process lost no batch (it begins counting at its first)" gr
 
 # --- 2 and 3. datagram loss, and a stalled subscriber -----------------------------------------
 duration_s=4
-lcm-logger --lcm-url="$url" -f -q --channel='LINES_CAM0|TEST_MARKER' "$work/lossy.lcm" &
+"${logger[@]}" --lcm-url="$url&$logger_buffer" -f -q --channel='LINES_CAM0|TEST_MARKER' "$work/lossy.lcm" &
 logger_pid=$!
-"$relay" "$url" EVENTS_RAW EVENTS_CAM0 20 2 >"$work/relay.out" &
+# The relay receives like the services (8 MiB buffer): a batch it missed would count as lost twice over.
+"$relay" "$url&$logger_buffer" EVENTS_RAW EVENTS_CAM0 20 2 >"$work/relay.out" &
 relay_pid=$!
 "$probe" "$url" cam0 600 >"$work/probe2.out" &
 probe_pid=$!

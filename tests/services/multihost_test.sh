@@ -56,7 +56,7 @@ check "ttl=0 traffic of host 2 does not reach host 3" test "$(grep -c '^invalid 
 
 "${h3[@]}" "$probe" "$url" cam0 600 >"$work/probe.out" &
 probe_pid=$!
-"${h3[@]}" lcm-logger --lcm-url="$url&recv_buf_size=8388608" -f -q "$work/far.lcm" &  # as the services ask
+"${h3[@]}" "${logger[@]}" --lcm-url="$url&$logger_buffer" -f -q "$work/far.lcm" &
 logger_pid=$!
 "${h3[@]}" "$viz" --lcm-url "$url" --headless --png-dir "$work/png" --png-period-s 0.5 >"$work/viz.out" 2>"$work/viz.err" &
 viz_pid=$!
@@ -73,7 +73,12 @@ batches=$(field "$work/camera.out" 'batches')
 check "host 3 heard a segment list of host 2 that includes host 1's last batch" \
   wait_until "a list including batch $((batches - 1))" probe_heard_batch "$work/probe.out" $((batches - 1))
 far_log_holds() { "${h2[@]}" "$junk" "$url" TEST_MARKER 1 && test "$("$log_count" "$work/far.lcm" EVENTS_CAM0)" -ge "$batches"; }
-check "lcm-logger on host 3 recorded every batch of host 1" wait_until "$batches batches in the far log" far_log_holds
+far_log_complete() {
+  wait_until "$batches batches in the far log" far_log_holds && return 0
+  echo "  the far log holds $("$log_count" "$work/far.lcm" EVENTS_CAM0) of $batches batches"
+  return 1
+}
+check "lcm-logger on host 3 recorded every batch of host 1" far_log_complete
 check "evldt-lines on host 2 stops promptly at SIGTERM" stops_promptly "$lines_pid"
 check "evldt-viz on host 3 stops promptly at SIGTERM" stops_promptly "$viz_pid"
 stops_promptly "$logger_pid" INT

@@ -13,9 +13,7 @@ replay_url="udpm://239.255.76.67:7712?ttl=0"
 scene=(--scene boxes-6dof --duration-s 1.5)
 
 # --- live run ---------------------------------------------------------------------------------
-# The logger gets the 8 MiB receive buffer the services ask for: with the default (208 KiB) it loses
-# batches whenever both cores are busy for a moment.
-lcm-logger --lcm-url="$url&recv_buf_size=8388608" -f -q "$work/live.lcm" &
+"${logger[@]}" --lcm-url="$url&$logger_buffer" -f -q "$work/live.lcm" &
 logger_pid=$!
 "$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines.out" 2>"$work/lines.err" &
 lines_pid=$!
@@ -34,7 +32,7 @@ check "camera exits 0" test $? -eq 0
 batches=$(field "$work/camera.out" 'batches')
 check "evldt-lines published a segment list that includes the last batch" \
   wait_until "a segment list including batch $((batches - 1))" probe_heard_batch "$work/probe.out" $((batches - 1))
-check "lcm-logger recorded every batch" wait_until "$batches batches in the log" log_holds "$url" "$work/live.lcm" EVENTS_CAM0 "$batches"
+check "lcm-logger recorded every batch" log_holds_all "$url" "$work/live.lcm" EVENTS_CAM0 "$batches"
 check "evldt-lines stops promptly at SIGTERM" stops_promptly "$lines_pid"
 check "evldt-viz stops promptly at SIGTERM" stops_promptly "$viz_pid"
 stops_promptly "$logger_pid" INT
@@ -63,7 +61,7 @@ check "live F@1% within 0.06 of offline" close_to "$live_f" "$offline_f" 0.06
 check "live F@1% >= 0.75" close_to "$live_f" 0.875 0.125
 
 # --- replay: lcm-logplayer feeds the recorded events to a fresh lines service ------------------
-lcm-logger --lcm-url="$replay_url&recv_buf_size=8388608" -f -q --channel='LINES_.*|TEST_MARKER' "$work/replay.lcm" &
+"${logger[@]}" --lcm-url="$replay_url&$logger_buffer" -f -q --channel='LINES_.*|TEST_MARKER' "$work/replay.lcm" &
 replay_logger_pid=$!
 "$lines" --lcm-url "$replay_url" --log-period-s 0 >"$work/replay_lines.out" 2>"$work/replay_lines.err" &
 replay_lines_pid=$!

@@ -10,6 +10,12 @@ junk=$build/tests/lcm_publish_junk
 probe=$build/tests/lcm_lines_probe
 relay=$build/tests/lcm_lossy_relay
 log_count=$build/tests/lcm_log_count
+# The stock lcm-logger (LCM 1.3) queues at most 30 messages per subscription and drops the rest
+# silently while its main loop waits for a core: with the services and a video encoder on two cores
+# it lost batches now and then. It runs at a higher priority (where allowed; nice warns and runs it
+# anyway elsewhere) and with the 8 MiB receive buffer the services ask for.
+logger=(nice -n -10 lcm-logger)
+logger_buffer="recv_buf_size=8388608"
 work=$(mktemp -d)
 failures=0
 cleanup_hooks=()
@@ -60,6 +66,12 @@ logger_has_marker() {
 # publishes a marker too: what it has received reaches the file.
 log_holds() {  # log_holds URL LOG_FILE CHANNEL COUNT: the log has at least COUNT messages on CHANNEL
   "$junk" "$1" TEST_MARKER 1 && test "$("$log_count" "$2" "$3")" -ge "$4"
+}
+
+log_holds_all() {  # log_holds_all URL LOG_FILE CHANNEL COUNT: waits for log_holds, else says how many arrived
+  wait_until "$4 messages on $3 in $(basename "$2")" log_holds "$@" && return 0
+  echo "  $(basename "$2") holds $("$log_count" "$2" "$3") of $4 messages on $3"
+  return 1
 }
 
 probe_heard_batch() {  # probe_heard_batch PROBE_OUT SEQ [EPOCH]: a segment list included batch SEQ
