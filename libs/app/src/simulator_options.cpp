@@ -16,6 +16,10 @@ void SimulatorOptions::add_to(CLI::App& app, bool scene_required) {
   group->add_option("--duration-s", duration_s_, "Scene duration in seconds (default: the scene's own)")
       ->check(finite_number() & CLI::Range(0.001, 3600.0));
   group->add_option("--seed", seed_, "Random seed (thresholds, noise)")->capture_default_str();
+  group->add_option("--motion-seed", motion_seed_,
+                    "Another recording of the scene: new phases, amplitudes and frequencies of the camera motion "
+                    "(0: the scene's own)")
+      ->capture_default_str();
   group->add_option("--contrast", contrast_, "Contrast threshold C+ = C- (log intensity; default 0.2)")
       ->check(finite_number() & CLI::Range(0.01, 5.0));
   group->add_option("--contrast-sigma", contrast_sigma_, "Per-pixel threshold spread (std dev; default 0.03, the scene's own)")
@@ -48,7 +52,7 @@ SimulatorConfig SimulatorOptions::config() const {
 }
 
 Scene SimulatorOptions::scene() const {
-  Scene s = make_scene(scene_);
+  Scene s = vary_camera_motion(make_scene(scene_), motion_seed_);
   if (duration_s_) s.duration_us = static_cast<Timestamp>(std::llround(*duration_s_ * 1e6));
   return s;
 }

@@ -1,7 +1,10 @@
 #include "evldt/sim/scenes.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
+
+#include "evldt/sim/random.hpp"
 
 namespace evldt {
 
@@ -227,6 +230,21 @@ Scene make_scene(std::string_view name) {
   std::string valid;
   for (const auto& n : scene_names()) valid += (valid.empty() ? "" : ", ") + n;
   throw std::invalid_argument("unknown scene '" + std::string(name) + "' (built-in scenes: " + valid + ")");
+}
+
+Scene vary_camera_motion(Scene scene, std::uint64_t seed) {
+  if (seed == 0) return scene;
+  SimRandom random(seed);
+  const auto scale = [&random] { return std::exp(std::log(0.8) + random.uniform() * (std::log(1.25) - std::log(0.8))); };
+  Motion& m = scene.camera;
+  for (MotionChannel* channel : {&m.tx, &m.ty, &m.angle, &m.log_scale, &m.perspective_x, &m.perspective_y}) {
+    if (channel->amplitude == 0) continue;
+    channel->phase = 2.0 * std::numbers::pi * random.uniform();
+    channel->amplitude *= scale();
+    channel->frequency_hz *= scale();
+  }
+  scene.name += "/m" + std::to_string(seed);
+  return scene;
 }
 
 }  // namespace evldt

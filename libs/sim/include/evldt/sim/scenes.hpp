@@ -1,6 +1,7 @@
 #pragma once
 // The built-in scenes, by name (see README: each mirrors a recording of the seed paper).
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,5 +19,10 @@ Scene make_scene(std::string_view name);
 /// The event-camera model a scene is seen through: the default for most, a noisy, flickering or
 /// dark sensor for the scenes made for those (noisy-boxes, flicker-lamps, night-boxes).
 SimulatorConfig scene_camera_model(std::string_view name);
+/// Another recording of the same scene: every oscillation of the camera motion gets a new phase and
+/// its amplitude and frequency scaled by 0.8-1.25, drawn from `seed` (the scene itself for seed 0).
+/// The name gets "/m<seed>". For held-out runs: parameters tuned on a scene are scored on its
+/// variants too.
+Scene vary_camera_motion(Scene scene, std::uint64_t seed);
 
 }  // namespace evldt
