@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
   using namespace evldt;
   CLI::App app{"evldt-viz: show events and segments of EVENTS_<CAMERA>/LINES_<CAMERA> (LCM), with the rates of\n"
                "EVLDT_STATS. Colours: yellow detected, green good track, red bad track. A window unless --headless;\n"
-               "--video and --png-dir record what is drawn. Runs until SIGINT/SIGTERM (or q in the window)."};
+               "--video and --png-dir record what is drawn. Runs until SIGINT/SIGTERM (or q in the window).\n"
+               "In the window, keys toggle what is drawn: e events, s segments, b bad tracks, g block grid, i ids."};
   LcmOptions lcm_options;
   VizNodeOptions options;
   std::filesystem::path video, png_dir;
@@ -36,7 +37,9 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(1.0, 240.0));
   app.add_option("--scale", options.render.scale, "Zoom")->capture_default_str()->check(CLI::Range(1, 8));
-  app.add_flag("--show-ids", options.render.show_ids, "Write line ids beside the segments");
+  app.add_flag("--show-ids", options.render.show_ids,
+               "Write line ids beside the segments, as short numbers in order of first appearance (key i)");
+  app.add_flag("--show-grid", options.render.show_grid, "Draw the lattice's block borders (key g)");
   return run_main(app, argc, argv, [&] {
     if (headless && video.empty() && png_dir.empty()) {
       throw std::invalid_argument("--headless draws nothing visible: add --video FILE and/or --png-dir DIR");
@@ -46,6 +49,7 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("no display (DISPLAY is not set): run with --headless and --video and/or --png-dir");
     }
     options.camera = lcm_options.camera();
+    options.show_key_help = !headless;
     const auto& stop = stop_on_signals();
     const auto lcm = lcm_options.connect();
     VizNode node(*lcm, options);
@@ -68,6 +72,7 @@ int main(int argc, char** argv) {
         cv::imshow(window, frame);
         const int key = cv::waitKey(1);
         if (key == 'q' || key == 27) return false;
+        node.apply_key(key);
       }
       return true;
     });

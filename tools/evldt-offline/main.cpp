@@ -40,7 +40,7 @@ class FrameSink {
   FrameSink(const Options& options, SensorSize sensor)
       : period_us_(options.render_period_us),
         sensor_(sensor),
-        render_{options.render_scale, options.show_ids},
+        render_{.scale = options.render_scale, .show_ids = options.show_ids},
         writer_(options.video, options.frames_dir, 1e6 / static_cast<double>(options.render_period_us),
                 cv::Size(sensor.width * options.render_scale, sensor.height * options.render_scale)) {}
   [[nodiscard]] bool enabled() const { return writer_.enabled(); }

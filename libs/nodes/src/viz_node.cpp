@@ -76,7 +76,12 @@ void VizNode::on_stats(const lcm::ReceiveBuffer* buffer, const std::string&) {
 
 void VizNode::render(cv::Mat& canvas) {
   const SensorSize sensor = *receiver_.sensor();
-  render_scene(sensor, lattice_->surface(), lines_, options_.render, canvas);
+  ids_.clear();
+  for (const TrackedLine& line : lines_) ids_.push_back(line.id);
+  short_ids_.label(ids_, labels_);
+  RenderOptions render = options_.render;
+  render.grid_block_size = lattice_->geometry().block_size;
+  render_scene(sensor, lattice_->surface(), lines_, render, canvas, labels_);
   const ReceiverCounts counts = receiver_.counts();
   put_line(canvas,
            fmt::format("{}  t={:.3f}s  {:.2f} Mev/s  {} lines", options_.camera, static_cast<double>(lines_t_us_) * 1e-6,
@@ -92,9 +97,11 @@ void VizNode::render(cv::Mat& canvas) {
   } else {
     put_line(canvas, "no statistics from evldt-lines yet", 1);
   }
+  int row = 2;
   if (counts.sequence.lost || counts.invalid_messages) {
-    put_line(canvas, fmt::format("viz: {} batches lost, {} invalid", counts.sequence.lost, counts.invalid_messages), 2);
+    put_line(canvas, fmt::format("viz: {} batches lost, {} invalid", counts.sequence.lost, counts.invalid_messages), row++);
   }
+  if (options_.show_key_help) put_line(canvas, kLayerKeys, row);
 }
 
 bool VizNode::handle_pending(Clock::time_point deadline) {

@@ -15,11 +15,22 @@ cv::Scalar status_colour(LineStatus status) {
   return {255, 255, 255};
 }
 
+bool toggle_layer(RenderOptions& options, int key) {
+  switch (key) {
+    case 'e': options.show_events = !options.show_events; return true;
+    case 's': options.show_segments = !options.show_segments; return true;
+    case 'b': options.show_bad_tracks = !options.show_bad_tracks; return true;
+    case 'g': options.show_grid = !options.show_grid; return true;
+    case 'i': options.show_ids = !options.show_ids; return true;
+    default: return false;
+  }
+}
+
 void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std::span<const TrackedLine> lines,
-                  const RenderOptions& options, cv::Mat& canvas) {
+                  const RenderOptions& options, cv::Mat& canvas, std::span<const std::uint32_t> labels) {
   const int scale = std::max(1, options.scale);
   cv::Mat grey(sensor.height, sensor.width, CV_8UC1, cv::Scalar(0));
-  if (surface.size() == static_cast<std::size_t>(sensor.width) * sensor.height) {
+  if (options.show_events && surface.size() == static_cast<std::size_t>(sensor.width) * sensor.height) {
     for (int y = 0; y < sensor.height; ++y) {
       auto* row = grey.ptr<std::uint8_t>(y);
       for (int x = 0; x < sensor.width; ++x) {
@@ -38,13 +49,24 @@ void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std
     return cv::Point(static_cast<int>(std::lround(p.x() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)),
                      static_cast<int>(std::lround(p.y() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)));
   };
+  if (options.show_grid && options.grid_block_size > 0) {
+    // Block borders lie on the lattice lines b/2 + k b (scarf_lattice.hpp).
+    const cv::Scalar grid(90, 60, 40);
+    const int b = options.grid_block_size, half = b / 2;
+    for (int x = half; x <= sensor.width; x += b) cv::line(canvas, {x * scale, 0}, {x * scale, canvas.rows - 1}, grid, 1);
+    for (int y = half; y <= sensor.height; y += b) cv::line(canvas, {0, y * scale}, {canvas.cols - 1, y * scale}, grid, 1);
+  }
   const int thickness = std::max(1, scale / 2);
-  for (const TrackedLine& line : lines) {
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const TrackedLine& line = lines[i];
+    const bool bad = line.status == LineStatus::BadTrack;
+    if (bad ? !options.show_bad_tracks : !options.show_segments) continue;
     const cv::Scalar colour = status_colour(line.status);
     cv::line(canvas, to_canvas(line.segment.q0), to_canvas(line.segment.q1), colour, thickness, cv::LINE_AA, kShift);
     if (options.show_ids) {
       const Point2 c = line.segment.centre();
-      cv::putText(canvas, std::to_string(line.id), cv::Point(static_cast<int>(c.x() * static_cast<float>(scale)) + 3, static_cast<int>(c.y() * static_cast<float>(scale))),
+      const std::string text = i < labels.size() ? std::to_string(labels[i]) : std::to_string(line.id);
+      cv::putText(canvas, text, cv::Point(static_cast<int>(c.x() * static_cast<float>(scale)) + 3, static_cast<int>(c.y() * static_cast<float>(scale))),
                   cv::FONT_HERSHEY_PLAIN, 0.8, colour, 1, cv::LINE_AA);
     }
   }

@@ -12,6 +12,7 @@
 
 #include "evldt/lines/params.hpp"
 #include "evldt/render/scene_renderer.hpp"
+#include "evldt/render/short_ids.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 
@@ -21,8 +22,9 @@ struct VizNodeOptions {
   std::string camera = "cam0";
   std::optional<SensorSize> sensor;  ///< unset: the first valid batch's
   double render_hz = 30;
-  RenderOptions render{2, false};
+  RenderOptions render{.scale = 2};
   Timestamp time_slack_us = 1000;
+  bool show_key_help = false;  ///< a line naming the layer keys (for a window)
 };
 
 struct VizTotals {
@@ -47,6 +49,9 @@ class VizNode {
   /// has already arrived (for at most kStopDrain) so that the totals count it. Everything runs on the calling thread
   /// (window toolkits need it).
   void run(const std::atomic<bool>& stop, const FrameHandler& on_frame);
+  /// A key pressed in the window: toggles a layer of kLayerKeys from the next frame on; false for
+  /// other keys. Call from the thread that runs the node (the frame handler).
+  bool apply_key(int key) { return toggle_layer(options_.render, key); }
   /// Counts so far (call from the thread that runs the node, e.g. in the frame handler, or after run).
   [[nodiscard]] VizTotals totals() const;
   static constexpr std::chrono::milliseconds kStopDrain{200};
@@ -70,6 +75,9 @@ class VizNode {
   double event_rate_ = 0;
   segment_list_t lines_msg_;
   std::vector<TrackedLine> lines_, incoming_;
+  ShortIds short_ids_;  // labels the ids of each drawn list
+  std::vector<std::uint64_t> ids_;
+  std::vector<std::uint32_t> labels_;
   Timestamp lines_t_us_ = 0;
   stats_t stats_msg_;
   std::optional<stats_t> stats_;

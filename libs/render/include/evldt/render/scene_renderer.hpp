@@ -10,17 +10,30 @@
 
 namespace evldt {
 
+/// What is drawn. The viz window toggles each layer with a key (toggle_layer).
 struct RenderOptions {
-  int scale = 1;          ///< integer zoom of the output image
-  bool show_ids = false;  ///< write each line's id beside it
+  int scale = 1;                ///< integer zoom of the output image
+  bool show_ids = false;        ///< write each line's label beside it
+  bool show_events = true;      ///< the SCARF surface
+  bool show_segments = true;    ///< detected and well-tracked segments
+  bool show_bad_tracks = true;  ///< segments whose last track scored below the threshold
+  bool show_grid = false;       ///< the lattice's block borders
+  int grid_block_size = 0;      ///< spacing of the grid (b); 0: no grid
 };
+
+/// The keys toggle_layer knows, for a help line.
+inline constexpr const char* kLayerKeys = "keys: e events, s segments, b bad tracks, g block grid, i ids, q quit";
+/// Flips the layer of a key of kLayerKeys; false for any other key.
+bool toggle_layer(RenderOptions& options, int key);
 
 cv::Scalar status_colour(LineStatus status);
 
-/// Fills `canvas` (resized to the sensor size times scale, BGR) with the surface and the segments.
+/// Fills `canvas` (resized to the sensor size times scale, BGR) with the layers `options` selects.
 /// `surface` is the per-pixel active-entry count of a lattice built with keep_surface (may be empty).
+/// `labels` are written beside the lines with show_ids (one per line, e.g. from ShortIds; empty: the
+/// lines' ids).
 void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std::span<const TrackedLine> lines,
-                  const RenderOptions& options, cv::Mat& canvas);
+                  const RenderOptions& options, cv::Mat& canvas, std::span<const std::uint32_t> labels = {});
 
 /// Rings the pixels (y * width + x) the hot-pixel filter masks, in magenta, on a canvas that
 /// render_scene drew at `scale`; indices off the sensor are ignored.

@@ -1,0 +1,84 @@
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "evldt/render/scene_renderer.hpp"
+#include "evldt/render/short_ids.hpp"
+
+namespace evldt {
+namespace {
+
+TEST(ShortIds, NumbersIdsInOrderOfFirstAppearanceAndKeepsThemWhileSeen) {
+  ShortIds ids(3);
+  std::vector<std::uint32_t> labels;
+  ids.label(std::vector<std::uint64_t>{1'733'000'000'001, 1'733'000'000'002}, labels);
+  EXPECT_EQ(labels, (std::vector<std::uint32_t>{1, 2}));
+  ids.label(std::vector<std::uint64_t>{1'733'000'000'002, 1'733'000'000'007}, labels);
+  EXPECT_EQ(labels, (std::vector<std::uint32_t>{2, 3}));
+  // Id ...001 was last seen at call 1; at call 3 it has been away for 2 calls and is kept, so a
+  // re-associated id comes back under its old number.
+  ids.label(std::vector<std::uint64_t>{1'733'000'000'001}, labels);
+  EXPECT_EQ(labels, (std::vector<std::uint32_t>{1}));
+  // Calls 4-6 without it: forgotten at call 6 (away for 3 calls); numbers are never reused.
+  for (int call = 4; call <= 6; ++call) ids.label(std::vector<std::uint64_t>{1'733'000'000'007}, labels);
+  EXPECT_EQ(ids.remembered(), 1u);
+  ids.label(std::vector<std::uint64_t>{1'733'000'000'001}, labels);
+  EXPECT_EQ(labels, (std::vector<std::uint32_t>{4}));
+}
+
+TEST(ToggleLayer, EachKeyFlipsItsLayerAndOtherKeysNothing) {
+  RenderOptions options;
+  EXPECT_TRUE(toggle_layer(options, 'e'));
+  EXPECT_FALSE(options.show_events);
+  EXPECT_TRUE(toggle_layer(options, 's'));
+  EXPECT_FALSE(options.show_segments);
+  EXPECT_TRUE(toggle_layer(options, 'b'));
+  EXPECT_FALSE(options.show_bad_tracks);
+  EXPECT_TRUE(toggle_layer(options, 'g'));
+  EXPECT_TRUE(options.show_grid);
+  EXPECT_TRUE(toggle_layer(options, 'i'));
+  EXPECT_TRUE(options.show_ids);
+  const RenderOptions before = options;
+  EXPECT_FALSE(toggle_layer(options, 'x'));
+  EXPECT_FALSE(toggle_layer(options, -1));  // no key pressed
+  EXPECT_EQ(options.show_events, before.show_events);
+}
+
+constexpr SensorSize kSensor{40, 30};
+
+cv::Vec3b pixel(const cv::Mat& canvas, int x, int y) { return canvas.at<cv::Vec3b>(y, x); }
+bool black(const cv::Vec3b& p) { return p == cv::Vec3b(0, 0, 0); }
+
+TEST(RenderScene, LayersAppearOnlyWhenSwitchedOn) {
+  std::vector<std::uint16_t> surface(static_cast<std::size_t>(kSensor.width * kSensor.height), 0);
+  surface[static_cast<std::size_t>(25 * kSensor.width + 30)] = 1;  // one active pixel at (30, 25)
+  TrackedLine good{.id = 7, .segment = {Point2(5, 10.5f), Point2(25, 10.5f)}, .status = LineStatus::GoodTrack};
+  TrackedLine bad{.id = 8, .segment = {Point2(5, 20.5f), Point2(25, 20.5f)}, .status = LineStatus::BadTrack};
+  const std::vector<TrackedLine> lines = {good, bad};
+  cv::Mat canvas;
+  RenderOptions options;  // scale 1: canvas pixels are sensor pixels
+  render_scene(kSensor, surface, lines, options, canvas);
+  EXPECT_FALSE(black(pixel(canvas, 30, 25)));
+  EXPECT_FALSE(black(pixel(canvas, 15, 10)));
+  EXPECT_FALSE(black(pixel(canvas, 15, 20)));
+  EXPECT_TRUE(black(pixel(canvas, 2, 2)));  // no grid by default
+
+  options.show_events = false;
+  options.show_bad_tracks = false;
+  render_scene(kSensor, surface, lines, options, canvas);
+  EXPECT_TRUE(black(pixel(canvas, 30, 25)));
+  EXPECT_FALSE(black(pixel(canvas, 15, 10)));
+  EXPECT_TRUE(black(pixel(canvas, 15, 20)));
+
+  options.show_segments = false;
+  options.show_grid = true;
+  options.grid_block_size = 8;  // borders at 4, 12, 20, ...
+  render_scene(kSensor, surface, lines, options, canvas);
+  EXPECT_TRUE(black(pixel(canvas, 15, 10)));
+  EXPECT_FALSE(black(pixel(canvas, 4, 2)));
+  EXPECT_FALSE(black(pixel(canvas, 2, 12)));
+  EXPECT_TRUE(black(pixel(canvas, 2, 2)));
+}
+
+}  // namespace
+}  // namespace evldt
