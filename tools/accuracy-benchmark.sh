@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Accuracy benchmark: every built-in scene through the deterministic pipeline and the evaluator with
 # the default parameters, then again without the noise filters ("/none" rows); one table (line
-# heat-map P/R/F at 1% and 2% of the diagonal, segments per step, ids, lifetimes, event rate).
+# heat-map P/R/F at 1% and 2% of the diagonal, segments per step, ids, lifetimes, tracking metrics,
+# event rate), a row for the block segments and one for the whole lines of each run.
 # Usage: tools/accuracy-benchmark.sh [BUILD_DIR] [OUT_DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -22,9 +23,11 @@ for filters in default none; do
       --lifetime-png "$out/$name-lifetimes.png" >"$out/$name.txt"
     if ((printed_header == 0)); then head -1 "$out/$name.txt"; printed_header=1; fi
     rate=$(python3 -c "import json; r = json.load(open('$out/$name.json'))['runs'][0]; print(f\"{r['events'] / r['scene_seconds'] / 1e6:.2f}\")")
-    line=$(tail -1 "$out/$name.txt")
-    [[ $filters == none ]] && line="${line/$scene/$scene/none}"
-    echo "$line   ${rate} Mev/s"
+    # A row for the segments and one for the whole lines of the same run.
+    while IFS= read -r line; do
+      [[ $filters == none ]] && line="${line/$scene/$scene/none}"
+      echo "$line   ${rate} Mev/s"
+    done < <(tail -n +2 "$out/$name.txt")
   done
 done
 echo "per-scene JSON and lifetime histograms in $out"

@@ -36,6 +36,7 @@ struct Options {
 struct Report {
   std::string label;
   std::optional<float> threshold;  ///< set for pipeline runs; a segment file's is unknown
+  bool whole_lines = false;        ///< the whole lines of a pipeline run
   std::vector<Prf> summed;
   double mean_predicted = 0, mean_ground_truth = 0;
   std::uint64_t steps = 0;
@@ -193,12 +194,14 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
   if (!out) throw std::runtime_error("error writing " + options.json.string());
 }
 
-// With several runs (--pr-thresholds) each run's chart gets its own file: NAME-f<threshold>.png.
+// Each run's chart gets its own file: the whole lines' NAME-whole.png, and with several runs
+// (--pr-thresholds) NAME-f<threshold>.png.
 std::filesystem::path run_path(const std::filesystem::path& path, const Report& report, bool several_runs) {
-  if (!several_runs || !report.threshold) return path;
+  std::string stem = path.stem().string();
+  if (several_runs && report.threshold) stem += fmt::format("-f{:g}", static_cast<double>(*report.threshold));
+  if (report.whole_lines) stem += "-whole";
   std::filesystem::path result = path;
-  result.replace_filename(path.stem().string() + fmt::format("-f{:g}", static_cast<double>(*report.threshold)) +
-                          path.extension().string());
+  result.replace_filename(stem + path.extension().string());
   return result;
 }
 
@@ -206,7 +209,7 @@ void write_run_plots(const Options& options, const StreamEvaluator& evaluator, c
   if (!options.lifetime_png.empty()) {
     write_histogram_png(run_path(options.lifetime_png, report, several_runs),
                         evaluator.lifetimes().histogram(options.histogram_bin_ms), options.histogram_bin_ms,
-                        report.label + " segment lifetimes");
+                        report.label + (report.whole_lines ? " whole-line lifetimes" : " segment lifetimes"));
   }
   if (!options.tracks_png.empty()) {
     write_id_timeline_png(run_path(options.tracks_png, report, several_runs), evaluator.tracking().lines(),
@@ -250,16 +253,22 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       config.score.fit_threshold = threshold;
       const auto started = std::chrono::steady_clock::now();
       last.emplace(make_scene_evaluator(scene, options.tolerances, options.step_us));
-      const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last);
-      Report r = make_report(*last);
-      r.label = scene.name;
-      r.threshold = threshold;
-      r.events = result.events;
-      r.scene_seconds = result.scene_seconds;
-      r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-      spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, r.events, r.wall_seconds);
-      write_run_plots(options, *last, r, thresholds.size() > 1);
-      reports.push_back(r);
+      StreamEvaluator whole = make_scene_evaluator(scene, options.tolerances, options.step_us);
+      const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole);
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, result.events, wall);
+      for (const auto& [evaluator, label] : {std::pair<const StreamEvaluator*, std::string>{&*last, scene.name},
+                                             {&whole, scene.name + " whole"}}) {
+        Report r = make_report(*evaluator);
+        r.label = label;
+        r.whole_lines = evaluator == &whole;
+        r.threshold = threshold;
+        r.events = result.events;
+        r.scene_seconds = result.scene_seconds;
+        r.wall_seconds = wall;
+        write_run_plots(options, *evaluator, r, thresholds.size() > 1);
+        reports.push_back(r);
+      }
     }
   }
   print_table(reports, options);

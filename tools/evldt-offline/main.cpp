@@ -14,6 +14,7 @@
 #include "evldt/events/event_validator.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/lines/segment_csv.hpp"
+#include "evldt/lines/whole_lines.hpp"
 #include "evldt/render/frame_writer.hpp"
 #include "evldt/render/scene_renderer.hpp"
 
@@ -24,6 +25,7 @@ using Clock = std::chrono::steady_clock;
 
 struct Options {
   std::filesystem::path output = "segments.csv";
+  std::filesystem::path whole_lines;
   Timestamp output_period_us = 10000;
   std::filesystem::path summary_json;
   std::filesystem::path video;
@@ -76,9 +78,17 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   FrameSink frames(options, *sensor);
   DeterministicPipeline pipeline(config, /*keep_surface=*/frames.enabled());
   SegmentCsvWriter csv(options.output);
+  std::optional<SegmentCsvWriter> whole_csv;
+  if (!options.whole_lines.empty()) whole_csv.emplace(options.whole_lines);
+  WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
+  std::vector<TrackedLine> joined;
   pipeline.set_output(options.output_period_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice& lattice) {
     csv.write_step(t, lines.lines());
     frames.step(t, lines, lattice);
+    if (!whole_csv) return;
+    joiner.update(t, lines.lines());
+    as_tracked_lines(joiner.lines(), joined);
+    whole_csv->write_step(t, joined);
   });
 
   spdlog::info("{}: {}x{}, b={} N={} dq={} f_th={}", source.name(), sensor->width, sensor->height, config.lattice.block_size, pipeline.lattice().geometry().capacity,
@@ -109,6 +119,12 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     summary.input_error = error.what();
   }
   csv.close();
+  if (whole_csv) {
+    whole_csv->close();
+    summary.whole_lines_path = options.whole_lines.string();
+    summary.whole_lines_created = joiner.created();
+    summary.whole_line_rows = whole_csv->rows();
+  }
 
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();
   summary.event_seconds = first_t ? static_cast<double>(validator.newest_time() - *first_t) * 1e-6 : 0.0;
@@ -133,6 +149,9 @@ int main(int argc, char** argv) {
   SourceOptions source_options;
   source_options.add_to(app);
   app.add_option("-o,--output", options.output, "Segment CSV to write")->capture_default_str();
+  app.add_option("--whole-lines", options.whole_lines,
+                 "Also write whole lines (collinear touching segments joined, with their own ids) as CSV in the segment "
+                 "format: score = segments joined, status good");
   app.add_option("--output-period-us", options.output_period_us, "Event time between CSV rows of segments")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{1}, Timestamp{60'000'000}));

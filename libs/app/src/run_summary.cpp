@@ -76,6 +76,10 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
   std::fprintf(out, "  output           %" PRIu64 " CSV rows -> %s", csv_rows, csv_path.c_str());
   if (frames > 0) std::fprintf(out, ", %d frames rendered", frames);
   std::fprintf(out, "\n");
+  if (!whole_lines_path.empty()) {
+    std::fprintf(out, "  whole lines      %" PRIu64 " ids, %" PRIu64 " CSV rows -> %s\n", whole_lines_created, whole_line_rows,
+                 whole_lines_path.c_str());
+  }
 }
 
 void RunSummary::write_json(const std::filesystem::path& path) const {
@@ -102,7 +106,8 @@ void RunSummary::write_json(const std::filesystem::path& path) const {
   }
   out << "},\n  \"lifetime_mean_ms\": " << lifetimes.mean_us() * 1e-3 << ",\n";
   out << "  \"lifetime_max_ms\": " << static_cast<double>(lifetimes.max_us) * 1e-3 << ",\n";
-  out << "  \"csv_rows\": " << csv_rows << ",\n  \"frames\": " << frames << "\n}\n";
+  out << "  \"csv_rows\": " << csv_rows << ",\n  \"whole_lines_created\": " << whole_lines_created
+      << ",\n  \"whole_line_rows\": " << whole_line_rows << ",\n  \"frames\": " << frames << "\n}\n";
   if (!out) throw std::runtime_error("error writing " + path.string());
 }
 

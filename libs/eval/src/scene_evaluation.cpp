@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "evldt/events/event_validator.hpp"
+#include "evldt/lines/whole_lines.hpp"
 
 namespace evldt {
 
@@ -123,20 +124,29 @@ StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tol
 }
 
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
-                              Timestamp step_us, StreamEvaluator& evaluator) {
+                              Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines) {
   EventSimulator simulator(scene, sim);
   EventValidator validator(scene.sensor, 0);
   DeterministicPipeline pipeline(config);
+  WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
+  std::vector<TrackedLine> joined;
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted;
-  pipeline.set_output(step_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
+  const auto add = [&](StreamEvaluator& to, Timestamp t, std::span<const TrackedLine> lines) {
     ids.clear();
     predicted.clear();
-    for (const TrackedLine& line : lines.lines()) {
+    for (const TrackedLine& line : lines) {
       ids.push_back(line.id);
       predicted.push_back(line.segment);
     }
-    evaluator.add_prediction(t, ids, predicted);
+    to.add_prediction(t, ids, predicted);
+  };
+  pipeline.set_output(step_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
+    add(evaluator, t, lines.lines());
+    if (whole_lines == nullptr) return;
+    joiner.update(t, lines.lines());
+    as_tracked_lines(joiner.lines(), joined);
+    add(*whole_lines, t, joined);
   });
   SceneRunResult result;
   EventBatch batch;
@@ -149,6 +159,7 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
     if (!more) break;
   }
   evaluator.finish();
+  if (whole_lines != nullptr) whole_lines->finish();
   result.scene_seconds = static_cast<double>(scene.duration_us) * 1e-6;
   result.counters = pipeline.counters();
   return result;

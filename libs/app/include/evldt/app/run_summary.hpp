@@ -28,6 +28,9 @@ struct RunSummary {
   std::uint64_t released[kReleaseReasonCount] = {};
   LifetimeStats lifetimes;  ///< released and live lines
   std::uint64_t csv_rows = 0;
+  std::uint64_t whole_lines_created = 0;  ///< with a whole-line CSV: distinct whole-line ids
+  std::uint64_t whole_line_rows = 0;
+  std::string whole_lines_path;          ///< empty: no whole lines written
   int frames = 0;
 
   /// Takes the filter chain, its counts, the round counters, line counts and lifetimes (released

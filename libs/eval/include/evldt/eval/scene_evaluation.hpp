@@ -101,9 +101,10 @@ struct SceneRunResult {
 
 /// Simulates the scene, runs the deterministic pipeline on it with an output every step_us and scores
 /// it on the scene's ground-truth steps (scene_ground_truth_steps) with a hold of
-/// kHoldPeriods * step_us. `evaluator` must have been made for those steps.
+/// kHoldPeriods * step_us. `evaluator` must have been made for those steps; so must `whole_lines`,
+/// which, when given, scores the whole lines (WholeLineTracker, config.whole_lines) of each output.
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
-                              Timestamp step_us, StreamEvaluator& evaluator);
+                              Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines = nullptr);
 
 /// The evaluator evaluate_scene expects for a scene.
 StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tolerance_fractions, Timestamp step_us);

@@ -51,12 +51,22 @@ struct ScheduleParams {
   int max_catch_up_rounds = 8;
 };
 
+/// Joining block segments into whole lines (whole_lines.hpp). Chosen on boxes-10s: tighter joins
+/// (8 degrees, 0.3 b, 1 b) split true lines and halved IDF1 (0.115 against 0.315).
+struct WholeLineParams {
+  float max_angle_deg = 12.0f;     ///< a segment joins a line whose direction is this close to its own
+  float max_offset_ratio = 0.6f;   ///< of b: both its ends within this of the line
+  float max_gap_ratio = 2.0f;      ///< of b: and it overlaps the line's extent or is at most this far from it
+  Timestamp keep_id_us = 100'000;  ///< a line not seen for this long gives up its id
+};
+
 struct PipelineConfig {
   FilterConfig filters;  ///< noise filters run before storage
   LatticeParams lattice;
   ScoreParams score;
   TrackParams track;
   ScheduleParams schedule;
+  WholeLineParams whole_lines;
 };
 
 /// DESIGN section 5 defaults for a sensor: b and dq from the nearest listed resolution, dq scaled by width.
