@@ -48,6 +48,15 @@ void PipelineOptions::add_to(CLI::App& app) {
   group->add_option("--reassociation-max-offset", reassociation_offset_,
                     "... and its centre lies within this fraction of b from the released line")
       ->check(finite_number() & CLI::Range(0.0, 4.0));
+  group->add_option("--whole-line-max-angle", whole_angle_,
+                    "Whole lines: a segment joins a line whose direction is within this (degrees)")
+      ->check(finite_number() & CLI::Range(0.0, 90.0));
+  group->add_option("--whole-line-max-offset", whole_offset_, "... with both ends within this fraction of b of it")
+      ->check(finite_number() & CLI::Range(0.0, 4.0));
+  group->add_option("--whole-line-max-gap", whole_gap_, "... and at most this fraction of b beyond its ends")
+      ->check(finite_number() & CLI::Range(0.0, 16.0));
+  group->add_option("--whole-line-keep-id-us", whole_keep_id_, "Whole lines: a line unseen this long gives up its id")
+      ->check(CLI::Range(Timestamp{0}, Timestamp{10'000'000}));
   group->add_option("--multi-block-norm", multi_block_norm_, "r_e divisor for lines over k blocks: block (N) or union (k*N)")
       ->check(CLI::IsMember({"block", "union"}));
   group->add_option("--track-period-us", track_period_, "Deterministic mode: tracking period in event time")
@@ -98,6 +107,10 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   if (reassociation_window_) config.track.reassociation.window_us = *reassociation_window_;
   if (reassociation_angle_) config.track.reassociation.max_angle_deg = *reassociation_angle_;
   if (reassociation_offset_) config.track.reassociation.max_offset_ratio = *reassociation_offset_;
+  if (whole_angle_) config.whole_lines.max_angle_deg = *whole_angle_;
+  if (whole_offset_) config.whole_lines.max_offset_ratio = *whole_offset_;
+  if (whole_gap_) config.whole_lines.max_gap_ratio = *whole_gap_;
+  if (whole_keep_id_) config.whole_lines.keep_id_us = *whole_keep_id_;
   if (multi_block_norm_) {
     config.track.multi_block_norm = *multi_block_norm_ == "union" ? EffectiveRatioNorm::Union : EffectiveRatioNorm::Block;
   }
