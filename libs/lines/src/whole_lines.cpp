@@ -193,13 +193,17 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   });
   id_of_cluster_.assign(count, kNoId);
   first_seen_of_cluster_.assign(count, t);
+  line_of_id_.clear();
+  for (std::size_t i = 0; i < lines_.size(); ++i) line_of_id_.emplace_back(lines_[i].id, i);
+  std::sort(line_of_id_.begin(), line_of_id_.end());
   for (const Vote& v : votes_) {
     if (id_of_cluster_[v.cluster] != kNoId) continue;
-    const auto previous = std::find_if(lines_.begin(), lines_.end(), [&](const WholeLine& l) { return l.id == v.id; });
-    if (previous == lines_.end() || previous->last_seen_us < 0) continue;  // taken by a line with more of it
+    const auto it = std::lower_bound(line_of_id_.begin(), line_of_id_.end(), std::pair(v.id, std::size_t{0}));
+    WholeLine& previous = lines_[it->second];  // every voted id is one of the last step's lines
+    if (previous.last_seen_us < 0) continue;  // taken by a line holding more of it
     id_of_cluster_[v.cluster] = v.id;
-    first_seen_of_cluster_[v.cluster] = previous->first_seen_us;
-    previous->last_seen_us = -1;  // marks it taken
+    first_seen_of_cluster_[v.cluster] = previous.first_seen_us;
+    previous.last_seen_us = -1;  // marks it taken
   }
   // Earlier lines nobody took have ended; they may be taken up again within keep_id_us.
   for (const WholeLine& l : lines_) {

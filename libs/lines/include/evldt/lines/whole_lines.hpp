@@ -70,6 +70,7 @@ class WholeLineTracker {
   std::vector<Timestamp> first_seen_of_cluster_;
   std::vector<std::pair<std::uint64_t, std::uint64_t>> owner_;  ///< (segment id, whole id) of the last step, sorted
   std::vector<std::pair<std::uint64_t, std::uint64_t>> next_owner_;
+  std::vector<std::pair<std::uint64_t, std::size_t>> line_of_id_;  ///< (id, index into lines_), sorted
   struct Vote {
     std::size_t cluster = 0;
     std::uint64_t id = 0;
