@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
   CLI::App app{"evldt-viz: show events and segments of EVENTS_<CAMERA>/LINES_<CAMERA> (LCM), with the rates of\n"
                "EVLDT_STATS. Colours: yellow detected, green good track, red bad track. A window unless --headless;\n"
                "--video and --png-dir record what is drawn. Runs until SIGINT/SIGTERM (or q in the window).\n"
-               "In the window, keys toggle what is drawn: e events, s segments, b bad tracks, g block grid, i ids."};
+               "In the window, keys toggle what is drawn: e events, s segments, b bad tracks, w whole lines, g block grid,\n"
+               "i ids."};
   LcmOptions lcm_options;
   VizNodeOptions options;
   std::filesystem::path video, png_dir;
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   app.add_flag("--show-ids", options.render.show_ids,
                "Write line ids beside the segments, as short numbers in order of first appearance (key i)");
   app.add_flag("--show-grid", options.render.show_grid, "Draw the lattice's block borders (key g)");
+  app.add_flag("--show-whole-lines", options.render.show_whole_lines, "Draw the whole lines of WHOLE_LINES_<CAMERA> (key w)");
   return run_main(app, argc, argv, [&] {
     if (headless && video.empty() && png_dir.empty()) {
       throw std::invalid_argument("--headless draws nothing visible: add --video FILE and/or --png-dir DIR");

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
+#include <set>
 #include <opencv2/core.hpp>
 #include <thread>
 
@@ -118,6 +119,7 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
   ListCollector collector(lcm, "LINES_CAM0");
+  ListCollector whole_collector(lcm, "WHOLE_LINES_CAM0");
   constexpr std::int64_t kEpoch = 5'000'000;
   const int kBlock = default_config_for(SensorSize{240, 180}).lattice.block_size;
   RunningLines lines(lcm, kEpoch);
@@ -172,6 +174,35 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
     }
   }
   EXPECT_GE(most_segments, 10u);  // boxes-6dof shows some 20 edges
+
+  // Whole lines: one list per segment list, published with it; each joins segments of that list
+  // (its score counts them), and a line keeps its id while it lasts.
+  // (LCM may hand over the last one of either kind after the snapshots above.)
+  const auto whole = whole_collector.lists();
+  ASSERT_LE(std::max(whole.size(), lists.size()) - std::min(whole.size(), lists.size()), 1u);
+  EXPECT_EQ(whole_collector.invalid(), 0);
+  std::size_t fewer = 0, continued = 0;
+  std::set<std::uint64_t> previous_ids;
+  const std::size_t both = std::min(whole.size(), lists.size());
+  for (std::size_t k = 0; k < both; ++k) {
+    EXPECT_EQ(whole[k].seq, static_cast<std::int64_t>(k));
+    EXPECT_EQ(whole[k].t_us, lists[k].t_us);
+    std::vector<TrackedLine> joined;
+    ASSERT_TRUE(read_segment_list(whole[k], joined));
+    double segments = 0;
+    std::set<std::uint64_t> ids;
+    for (const auto& line : joined) {
+      EXPECT_GE(line.id, static_cast<std::uint64_t>(kEpoch));
+      segments += line.score;
+      ids.insert(line.id);
+      continued += previous_ids.count(line.id);
+    }
+    EXPECT_EQ(segments, static_cast<double>(lists[k].segments.size()));
+    fewer += joined.size() < lists[k].segments.size() ? 1 : 0;
+    previous_ids = ids;
+  }
+  EXPECT_GT(fewer, both / 2);  // segments along one edge are joined
+  EXPECT_GT(continued, both);  // ids carry over from list to list
 }
 
 // Every statistics message a service publishes.
@@ -259,6 +290,7 @@ TEST(Nodes, GarbageAndForeignMessagesAreCountedNotFatal) {
 TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   lcm::LCM lcm("memq://");
   ListCollector collector(lcm, "LINES_CAM0");
+  ListCollector whole_collector(lcm, "WHOLE_LINES_CAM0");
   RunningLines lines(lcm, 1000);
   const std::atomic<bool> never{false};
   const auto source = scene_source("boxes-6dof", 200'000);
@@ -268,11 +300,17 @@ TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
     return !lists.empty() && lists.back().newest_batch_seq == static_cast<std::int64_t>(first.batches - 1);
   }));
   const std::size_t lists_before = collector.lists().size();
-  // The camera process restarts: a newer epoch, sequence and event time from zero again.
-  const CameraSummary second = CameraNode(lcm, fast_camera(), 2).run(source, never);
+  // The camera process restarts: a newer epoch, sequence and event time from zero again. It runs in
+  // real time, so that the new engine's state is published many times on the way (at full speed
+  // it could end before the next publish), and the wait is for every event to have arrived: the
+  // old engine's last list also names the last batch (same scene, same sequence numbers).
+  CameraNodeOptions real_time = fast_camera();
+  real_time.speed = 1;
+  const CameraSummary second = CameraNode(lcm, real_time, 2).run(source, never);
   ASSERT_TRUE(wait_for([&] {
     const auto lists = collector.lists();
-    return lists.size() > lists_before && lists.back().newest_batch_seq == static_cast<std::int64_t>(second.batches - 1) &&
+    return lines.node.totals().events_received == first.events_published + second.events_published &&
+           lists.size() > lists_before && lists.back().newest_batch_seq == static_cast<std::int64_t>(second.batches - 1) &&
            lists.back().t_us < 200'000 + 1000;
   }));
   lines.stop();
@@ -297,6 +335,21 @@ TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   ASSERT_GT(max_before, 0u);
   ASSERT_LT(min_after, UINT64_MAX);
   EXPECT_GT(min_after, max_before);
+
+  // So do the whole lines' (a list of them is published with each segment list).
+  const auto whole = whole_collector.lists();
+  ASSERT_LE(std::max(whole.size(), lists.size()) - std::min(whole.size(), lists.size()), 1u);
+  std::uint64_t whole_max_before = 0, whole_min_after = UINT64_MAX;
+  for (std::size_t i = 0; i < std::min(whole.size(), lists.size()); ++i) {
+    for (const auto& line : whole[i].segments) {
+      const auto id = static_cast<std::uint64_t>(line.id);
+      if (i < lists_before) whole_max_before = std::max(whole_max_before, id);
+      if (i >= lists_before && whole[i].t_us < whole[lists_before - 1].t_us) whole_min_after = std::min(whole_min_after, id);
+    }
+  }
+  ASSERT_GT(whole_max_before, 0u);
+  ASSERT_LT(whole_min_after, UINT64_MAX);
+  EXPECT_GT(whole_min_after, whole_max_before);
 }
 
 TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {

@@ -17,11 +17,14 @@ constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 
 }  // namespace
 
-WholeLineTracker::WholeLineTracker(int block_size, const WholeLineParams& params)
+WholeLineTracker::WholeLineTracker(int block_size, const WholeLineParams& params, std::uint64_t first_id)
     : block_size_(static_cast<float>(block_size)),
       params_(params),
       cell_size_(static_cast<float>(block_size) * std::max(1.0f, params.max_gap_ratio + params.max_offset_ratio)),
-      min_cos_angle_(std::cos(params_.max_angle_deg * std::numbers::pi_v<float> / 180.0f)) {
+      min_cos_angle_(std::cos(params_.max_angle_deg * std::numbers::pi_v<float> / 180.0f)),
+      first_id_(first_id),
+      next_id_(first_id) {
+  if (first_id == kNoId) throw std::invalid_argument("whole-line ids start above 0");
   if (block_size <= 0) throw std::invalid_argument("whole lines need a positive block size, got " + std::to_string(block_size));
 }
 

@@ -25,11 +25,13 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
       options_(std::move(options)),
       epoch_us_(epoch_us),
       lines_channel_(lines_channel(options_.camera)),
+      whole_lines_channel_(whole_lines_channel(options_.camera)),
       receiver_(options_.sensor, options_.time_slack_us,
                 [this](SensorSize size) {
                   return LatticeGeometry::fits(size, options_.configure(size).lattice.block_size);
                 }),
-      next_line_id_(static_cast<std::uint64_t>(epoch_us)) {
+      next_line_id_(static_cast<std::uint64_t>(epoch_us)),
+      next_whole_id_(static_cast<std::uint64_t>(epoch_us)) {
   batch_.reserve(1 << 16);
   if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100)) {
     throw std::invalid_argument("publish rate must be in (0, 10000] Hz and stats rate in (0, 100] Hz");
@@ -155,6 +157,29 @@ void LinesNode::publish_segments() {
   list_msg_.newest_batch_seq = included.seq;
   list_msg_.newest_batch_utime = included.utime;
   if (lcm_.publish(lines_channel_, &list_msg_) == 0) lists_published_.fetch_add(1, std::memory_order_relaxed);
+  if (options_.whole_lines) publish_whole_lines(engine, lattice_us);
+}
+
+void LinesNode::publish_whole_lines(const std::shared_ptr<RealtimeEngine>& engine, Timestamp lattice_us) {
+  // A new engine (camera restart, clock back) starts its whole lines afresh; ids go on, never repeated.
+  if (engine != joined_engine_ || (joiner_ && lattice_us < joiner_->last_time())) {
+    if (joiner_) next_whole_id_ += joiner_->created();
+    joiner_.emplace(engine->geometry().block_size, engine->config().whole_lines, next_whole_id_);
+    joined_engine_ = engine;
+  }
+  joiner_->update(lattice_us, lines_);
+  as_tracked_lines(joiner_->lines(), whole_);
+  fill_segment_list(whole_, whole_msg_);
+  whole_msg_.utime = list_msg_.utime;
+  whole_msg_.epoch = list_msg_.epoch;
+  whole_msg_.seq = whole_seq_++;
+  whole_msg_.source = list_msg_.source;
+  whole_msg_.width = list_msg_.width;
+  whole_msg_.height = list_msg_.height;
+  whole_msg_.t_us = list_msg_.t_us;
+  whole_msg_.newest_batch_seq = list_msg_.newest_batch_seq;
+  whole_msg_.newest_batch_utime = list_msg_.newest_batch_utime;
+  lcm_.publish(whole_lines_channel_, &whole_msg_);
 }
 
 void LinesNode::publish_stats(double period_s) {

@@ -33,6 +33,7 @@ VizNode::VizNode(lcm::LCM& lcm, VizNodeOptions options)
   // Drawing and encoding a frame takes milliseconds: queue the batches meanwhile (LCM's default is 30).
   subscriptions_.back()->setQueueCapacity(kEventQueueCapacity);
   subscriptions_.push_back(lcm_.subscribe(lines_channel(options_.camera), &VizNode::on_lines, this));
+  subscriptions_.push_back(lcm_.subscribe(whole_lines_channel(options_.camera), &VizNode::on_whole_lines, this));
   subscriptions_.push_back(lcm_.subscribe(std::string(kStatsChannel), &VizNode::on_stats, this));
 }
 
@@ -52,17 +53,26 @@ void VizNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
   events_since_frame_ += batch_.size();
 }
 
-void VizNode::on_lines(const lcm::ReceiveBuffer* buffer, const std::string&) {
+bool VizNode::decode_list(const lcm::ReceiveBuffer* buffer, std::vector<TrackedLine>& into) {
   // An invalid list is refused whole; the last valid one stays on screen.
   if (decode_message(payload_of(buffer), lines_msg_) != WireError::None || !read_segment_list(lines_msg_, incoming_)) {
     if (std::has_single_bit(++totals_.invalid_segment_lists)) {
       spdlog::warn("refused {} invalid segment list(s)", totals_.invalid_segment_lists);
     }
-    return;
+    return false;
   }
-  lines_.swap(incoming_);
+  into.swap(incoming_);
+  return true;
+}
+
+void VizNode::on_lines(const lcm::ReceiveBuffer* buffer, const std::string&) {
+  if (!decode_list(buffer, lines_)) return;
   lines_t_us_ = lines_msg_.t_us;
   ++totals_.segment_lists;
+}
+
+void VizNode::on_whole_lines(const lcm::ReceiveBuffer* buffer, const std::string&) {
+  if (decode_list(buffer, whole_lines_)) ++totals_.whole_line_lists;
 }
 
 void VizNode::on_stats(const lcm::ReceiveBuffer* buffer, const std::string&) {
@@ -82,6 +92,12 @@ void VizNode::render(cv::Mat& canvas) {
   RenderOptions render = options_.render;
   render.grid_block_size = lattice_->geometry().block_size;
   render_scene(sensor, lattice_->surface(), lines_, render, canvas, labels_);
+  if (render.show_whole_lines) {
+    ids_.clear();
+    for (const TrackedLine& line : whole_lines_) ids_.push_back(line.id);
+    short_whole_ids_.label(ids_, labels_);
+    draw_whole_lines(whole_lines_, render, canvas, labels_);
+  }
   const ReceiverCounts counts = receiver_.counts();
   put_line(canvas,
            fmt::format("{}  t={:.3f}s  {:.2f} Mev/s  {} lines", options_.camera, static_cast<double>(lines_t_us_) * 1e-6,

@@ -6,6 +6,28 @@
 
 namespace evldt {
 
+namespace {
+
+// Continuous coordinates -> OpenCV pixel-centre coordinates, drawn with 4 fractional bits.
+constexpr int kShift = 4;
+cv::Point to_canvas(const Point2& p, int scale) {
+  return cv::Point(static_cast<int>(std::lround(p.x() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)),
+                   static_cast<int>(std::lround(p.y() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)));
+}
+
+void draw_labelled(cv::Mat& canvas, const TrackedLine& line, const cv::Scalar& colour, int thickness, int scale,
+                   bool show_label, std::uint64_t label) {
+  cv::line(canvas, to_canvas(line.segment.q0, scale), to_canvas(line.segment.q1, scale), colour, thickness, cv::LINE_AA,
+           kShift);
+  if (!show_label) return;
+  const Point2 c = line.segment.centre();
+  cv::putText(canvas, std::to_string(label),
+              cv::Point(static_cast<int>(c.x() * static_cast<float>(scale)) + 3, static_cast<int>(c.y() * static_cast<float>(scale))),
+              cv::FONT_HERSHEY_PLAIN, 0.8, colour, 1, cv::LINE_AA);
+}
+
+}  // namespace
+
 cv::Scalar status_colour(LineStatus status) {
   switch (status) {
     case LineStatus::Detected: return {0, 220, 255};   // yellow
@@ -22,6 +44,7 @@ bool toggle_layer(RenderOptions& options, int key) {
     case 'b': options.show_bad_tracks = !options.show_bad_tracks; return true;
     case 'g': options.show_grid = !options.show_grid; return true;
     case 'i': options.show_ids = !options.show_ids; return true;
+    case 'w': options.show_whole_lines = !options.show_whole_lines; return true;
     default: return false;
   }
 }
@@ -43,12 +66,6 @@ void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std
   cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
   cv::resize(bgr, canvas, cv::Size(sensor.width * scale, sensor.height * scale), 0, 0, cv::INTER_NEAREST);
 
-  // Continuous coordinates -> OpenCV pixel-centre coordinates, drawn with 4 fractional bits.
-  constexpr int kShift = 4;
-  auto to_canvas = [&](const Point2& p) {
-    return cv::Point(static_cast<int>(std::lround(p.x() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)),
-                     static_cast<int>(std::lround(p.y() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)));
-  };
   if (options.show_grid && options.grid_block_size > 0) {
     // Block borders lie on the lattice lines b/2 + k b (scarf_lattice.hpp).
     const cv::Scalar grid(90, 60, 40);
@@ -61,14 +78,7 @@ void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std
     const TrackedLine& line = lines[i];
     const bool bad = line.status == LineStatus::BadTrack;
     if (bad ? !options.show_bad_tracks : !options.show_segments) continue;
-    const cv::Scalar colour = status_colour(line.status);
-    cv::line(canvas, to_canvas(line.segment.q0), to_canvas(line.segment.q1), colour, thickness, cv::LINE_AA, kShift);
-    if (options.show_ids) {
-      const Point2 c = line.segment.centre();
-      const std::string text = i < labels.size() ? std::to_string(labels[i]) : std::to_string(line.id);
-      cv::putText(canvas, text, cv::Point(static_cast<int>(c.x() * static_cast<float>(scale)) + 3, static_cast<int>(c.y() * static_cast<float>(scale))),
-                  cv::FONT_HERSHEY_PLAIN, 0.8, colour, 1, cv::LINE_AA);
-    }
+    draw_labelled(canvas, line, status_colour(line.status), thickness, scale, options.show_ids, i < labels.size() ? labels[i] : line.id);
   }
 }
 
@@ -79,6 +89,16 @@ void draw_masked_pixels(SensorSize sensor, std::span<const std::int32_t> pixels,
     if (pixel < 0 || pixel >= count) continue;
     const cv::Point centre((pixel % sensor.width) * scale + scale / 2, (pixel / sensor.width) * scale + scale / 2);
     cv::circle(canvas, centre, 2 + 2 * scale, cv::Scalar(255, 0, 255), 1, cv::LINE_AA);
+  }
+}
+
+void draw_whole_lines(std::span<const TrackedLine> lines, const RenderOptions& options, cv::Mat& canvas,
+                      std::span<const std::uint32_t> labels) {
+  if (!options.show_whole_lines) return;
+  const int scale = std::max(1, options.scale);
+  const cv::Scalar cyan(230, 210, 40);
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    draw_labelled(canvas, lines[i], cyan, std::max(2, scale), scale, options.show_ids, i < labels.size() ? labels[i] : lines[i].id);
   }
 }
 

@@ -28,6 +28,7 @@ void check_camera_name(std::string_view camera) {
 
 std::string events_channel(std::string_view camera) { return channel("EVENTS_", camera); }
 std::string lines_channel(std::string_view camera) { return channel("LINES_", camera); }
+std::string whole_lines_channel(std::string_view camera) { return channel("WHOLE_LINES_", camera); }
 
 std::int64_t wall_clock_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())

@@ -23,8 +23,9 @@ struct WholeLine {
 
 class WholeLineTracker {
  public:
-  /// block_size: the lattice's b, the unit of the distances in `params`.
-  WholeLineTracker(int block_size, const WholeLineParams& params = {});
+  /// block_size: the lattice's b, the unit of the distances in `params`. Ids start at first_id (a
+  /// service folds its start time in, as for segment ids).
+  explicit WholeLineTracker(int block_size, const WholeLineParams& params = {}, std::uint64_t first_id = 1);
 
   /// Joins the segments of one step into whole lines and carries ids over from the previous step:
   /// a line takes the id of the earlier line that most of its segments' length belonged to (each id
@@ -33,8 +34,10 @@ class WholeLineTracker {
   void update(Timestamp t, std::span<const TrackedLine> segments);
 
   [[nodiscard]] const std::vector<WholeLine>& lines() const { return lines_; }
+  /// Time of the last update (0 before the first).
+  [[nodiscard]] Timestamp last_time() const { return last_t_; }
   /// Distinct ids given so far.
-  [[nodiscard]] std::uint64_t created() const { return next_id_ - 1; }
+  [[nodiscard]] std::uint64_t created() const { return next_id_ - first_id_; }
 
  private:
   /// A line being grown: the length-weighted fit through its members' ends.
@@ -55,7 +58,8 @@ class WholeLineTracker {
   WholeLineParams params_;
   float cell_size_;  ///< of the grid of segment ends
   float min_cos_angle_;
-  std::uint64_t next_id_ = 1;
+  std::uint64_t first_id_;
+  std::uint64_t next_id_;
   bool stepped_ = false;
   Timestamp last_t_ = 0;
   std::vector<WholeLine> lines_;

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "evldt/lines/realtime_engine.hpp"
+#include "evldt/lines/whole_lines.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 #include "evldt/transport/latency_tracker.hpp"
 
@@ -26,6 +27,7 @@ struct LinesNodeOptions {
   double publish_hz = 100;
   double stats_hz = 1;
   double log_period_s = 10;  ///< a status line in the log this often (0: never)
+  bool whole_lines = true;   ///< also publish whole lines on WHOLE_LINES_<CAMERA>
 };
 
 /// Totals since start (what the stats message and the exit summary report).
@@ -60,6 +62,7 @@ class LinesNode {
   void start_engine();
   void publish_loop(const std::atomic<bool>& stop);
   void publish_segments();
+  void publish_whole_lines(const std::shared_ptr<RealtimeEngine>& engine, Timestamp lattice_us);
   void publish_stats(double period_s);
   [[nodiscard]] std::shared_ptr<RealtimeEngine> engine() const;
 
@@ -67,6 +70,7 @@ class LinesNode {
   LinesNodeOptions options_;
   std::int64_t epoch_us_;
   std::string lines_channel_;
+  std::string whole_lines_channel_;
   lcm::Subscription* subscription_ = nullptr;
 
   // Receive thread only.
@@ -86,6 +90,12 @@ class LinesNode {
   segment_list_t list_msg_;
   std::int64_t list_seq_ = 0;
   std::atomic<std::uint64_t> lists_published_{0};
+  std::optional<WholeLineTracker> joiner_;  ///< for the engine below (held, so a new one is told apart)
+  std::shared_ptr<const RealtimeEngine> joined_engine_;
+  std::uint64_t next_whole_id_;
+  std::vector<TrackedLine> whole_;
+  segment_list_t whole_msg_;
+  std::int64_t whole_seq_ = 0;
   LinesNodeTotals last_stats_;
   LatencySummary last_latency_;  ///< of the last statistics message, for the log line
 };

@@ -30,7 +30,8 @@ struct VizNodeOptions {
 struct VizTotals {
   ReceiverCounts events;
   std::uint64_t segment_lists = 0;
-  std::uint64_t invalid_segment_lists = 0;
+  std::uint64_t invalid_segment_lists = 0;  ///< of segments and of whole lines
+  std::uint64_t whole_line_lists = 0;
   std::uint64_t stats = 0;
   std::uint64_t frames = 0;
 };
@@ -62,6 +63,9 @@ class VizNode {
   bool handle_pending(Clock::time_point deadline);
   void on_events(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void on_lines(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void on_whole_lines(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  /// Decodes a segment list into `into`; an invalid one is counted and logged, and `into` kept.
+  bool decode_list(const lcm::ReceiveBuffer* buffer, std::vector<TrackedLine>& into);
   void on_stats(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void render(cv::Mat& canvas);
 
@@ -75,7 +79,8 @@ class VizNode {
   double event_rate_ = 0;
   segment_list_t lines_msg_;
   std::vector<TrackedLine> lines_, incoming_;
-  ShortIds short_ids_;  // labels the ids of each drawn list
+  std::vector<TrackedLine> whole_lines_;
+  ShortIds short_ids_, short_whole_ids_;  // label the ids of each drawn list
   std::vector<std::uint64_t> ids_;
   std::vector<std::uint32_t> labels_;
   Timestamp lines_t_us_ = 0;

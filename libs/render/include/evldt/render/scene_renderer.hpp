@@ -18,11 +18,13 @@ struct RenderOptions {
   bool show_segments = true;    ///< detected and well-tracked segments
   bool show_bad_tracks = true;  ///< segments whose last track scored below the threshold
   bool show_grid = false;       ///< the lattice's block borders
+  bool show_whole_lines = false;  ///< whole lines (draw_whole_lines), over the segments
   int grid_block_size = 0;      ///< spacing of the grid (b); 0: no grid
 };
 
 /// The keys toggle_layer knows, for a help line.
-inline constexpr const char* kLayerKeys = "keys: e events, s segments, b bad tracks, g block grid, i ids, q quit";
+inline constexpr const char* kLayerKeys =
+    "keys: e events, s segments, b bad tracks, w whole lines, g block grid, i ids, q quit";
 /// Flips the layer of a key of kLayerKeys; false for any other key.
 bool toggle_layer(RenderOptions& options, int key);
 
@@ -34,6 +36,11 @@ cv::Scalar status_colour(LineStatus status);
 /// lines' ids).
 void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std::span<const TrackedLine> lines,
                   const RenderOptions& options, cv::Mat& canvas, std::span<const std::uint32_t> labels = {});
+
+/// Draws whole lines (cyan, thicker than segments) on a canvas render_scene drew, if
+/// options.show_whole_lines; with show_ids, `labels` (one per line; empty: the ids) beside them.
+void draw_whole_lines(std::span<const TrackedLine> lines, const RenderOptions& options, cv::Mat& canvas,
+                      std::span<const std::uint32_t> labels = {});
 
 /// Rings the pixels (y * width + x) the hot-pixel filter masks, in magenta, on a canvas that
 /// render_scene drew at `scale`; indices off the sensor are ignored.
