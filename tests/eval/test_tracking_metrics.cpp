@@ -81,6 +81,7 @@ TEST(MaxWeightMatching, RejectsPairsOutOfRangeAndBadWeights) {
 Segment horizontal(float y, float x0, float x1) { return {Point2(x0, y), Point2(x1, y)}; }
 
 constexpr double kTolerance = 2.0;
+constexpr SensorSize kTrackSensor{200, 150};
 const Segment kLine = horizontal(20, 10, 110);  // 100 px long
 
 void step(TrackingEvaluator& evaluator, Timestamp t, std::vector<std::uint64_t> ids, std::vector<Segment> predicted,
@@ -89,7 +90,7 @@ void step(TrackingEvaluator& evaluator, Timestamp t, std::vector<std::uint64_t> 
 }
 
 TEST(TrackingEvaluator, OneIdOverTheWholeLifeIsPerfect) {
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   for (Timestamp t = 0; t < 10; ++t) step(evaluator, t, {42}, {horizontal(21, 10, 110)});
   const TrackingSummary s = evaluator.summary();
   EXPECT_EQ(s.ground_truth_lines, 1u);
@@ -103,7 +104,7 @@ TEST(TrackingEvaluator, OneIdOverTheWholeLifeIsPerfect) {
 }
 
 TEST(TrackingEvaluator, TwoHalvesWithTheirOwnIdsHalveIdf1ButDoNotSwitch) {
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   for (Timestamp t = 0; t < 10; ++t) step(evaluator, t, {1, 2}, {horizontal(20, 10, 60), horizontal(20, 60, 110)});
   const TrackingSummary s = evaluator.summary();
   EXPECT_DOUBLE_EQ(s.coverage, 1.0);
@@ -115,7 +116,7 @@ TEST(TrackingEvaluator, TwoHalvesWithTheirOwnIdsHalveIdf1ButDoNotSwitch) {
 }
 
 TEST(TrackingEvaluator, AHandOverIsOneSwitchAndTheRepresentativeHoldsWhileItMatches) {
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   for (Timestamp t = 0; t < 4; ++t) step(evaluator, t, {1}, {horizontal(20, 10, 40)});
   // Id 2 now covers more of the line, but id 1 still matches: it stays the representative.
   for (Timestamp t = 4; t < 6; ++t) step(evaluator, t, {1, 2}, {horizontal(20, 10, 40), horizontal(20, 40, 110)});
@@ -128,7 +129,7 @@ TEST(TrackingEvaluator, AHandOverIsOneSwitchAndTheRepresentativeHoldsWhileItMatc
 }
 
 TEST(TrackingEvaluator, AGapCostsCoverageButTheSameIdAfterItIsNoSwitch) {
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   step(evaluator, 0, {9}, {kLine});
   step(evaluator, 1, {}, {});
   step(evaluator, 2, {9}, {kLine});
@@ -146,7 +147,7 @@ TEST(TrackingEvaluator, ASegmentMatchesOnlyWhenEnoughOfItLiesOnTheLine) {
   // the line and the 2 px beyond its end).
   const Segment mostly_off = {Point2(70, 20), Point2(170, 20)};
   const Segment mostly_on = {Point2(50, 20), Point2(150, 20)};
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   step(evaluator, 0, {1}, {mostly_off});
   step(evaluator, 1, {2}, {mostly_on});
   const GroundTruthLineTrack& line = evaluator.lines().at(0);
@@ -160,14 +161,14 @@ TEST(TrackingEvaluator, ASegmentMatchesOnlyWhenEnoughOfItLiesOnTheLine) {
 
 TEST(TrackingEvaluator, PiecesOfOneLineCountEachSampleOnce) {
   // The line is seen as two overlapping pieces (e.g. clipped around an occluder, drawn twice).
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   step(evaluator, 0, {1}, {kLine}, {5, 5}, {horizontal(20, 10, 80), horizontal(20, 50, 110)});
   EXPECT_NEAR(evaluator.summary().id_true_positive_px, 100.0, 1e-4);
 }
 
 TEST(TrackingEvaluator, AnIdThatJumpsLinesIsGivenToTheLineItCoveredLonger) {
   const Segment other = horizontal(50, 10, 110);
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   for (Timestamp t = 0; t < 3; ++t) step(evaluator, t, {7}, {kLine}, {5, 6}, {kLine, other});
   for (Timestamp t = 3; t < 10; ++t) step(evaluator, t, {7}, {other}, {5, 6}, {kLine, other});
   const TrackingSummary s = evaluator.summary();
@@ -177,18 +178,29 @@ TEST(TrackingEvaluator, AnIdThatJumpsLinesIsGivenToTheLineItCoveredLonger) {
 }
 
 TEST(TrackingEvaluator, RejectsMismatchedSpansAndStepsOutOfOrder) {
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   const std::vector<std::uint64_t> two = {1, 2};
   const std::vector<Segment> one = {kLine};
   EXPECT_THROW(evaluator.add_step(0, two, one, {}, {}), std::invalid_argument);
   evaluator.add_step(5, {}, {}, {}, {});
   EXPECT_THROW(evaluator.add_step(4, {}, {}, {}, {}), std::invalid_argument);
-  EXPECT_THROW(TrackingEvaluator(-1.0), std::invalid_argument);
-  EXPECT_THROW(TrackingEvaluator(1.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(TrackingEvaluator(kTrackSensor, -1.0), std::invalid_argument);
+  EXPECT_THROW(TrackingEvaluator(kTrackSensor, 1.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(TrackingEvaluator(SensorSize{0, 10}, 1.0), std::invalid_argument);
+}
+
+TEST(TrackingEvaluator, OnlyTheSegmentsPartOnTheSensorIsMeasured) {
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
+  // From x = 10 to 1e30: sampled on the sensor only (the 190 px up to x = 200), in no time.
+  step(evaluator, 0, {1}, {horizontal(20, 10, 1e30f)});
+  const TrackingSummary s = evaluator.summary();
+  EXPECT_NEAR(s.predicted_px, 190.0, 1e-3);
+  EXPECT_NEAR(s.id_true_positive_px, 100.0 + kTolerance, 1e-3);
+  EXPECT_TRUE(evaluator.lines().at(0).owners.at(0).matched);  // 102 of 190 px: more than half
 }
 
 TEST(TrackingEvaluator, NothingPredictedIsNoIdentityAndNoCoverage) {
-  TrackingEvaluator evaluator(kTolerance);
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
   for (Timestamp t = 0; t < 3; ++t) step(evaluator, t, {}, {});
   const TrackingSummary s = evaluator.summary();
   EXPECT_EQ(s.coverage, 0.0);

@@ -64,6 +64,16 @@ void for_each_line_pixel(std::span<const std::uint8_t> map, int width, Visit vis
 
 }  // namespace
 
+std::optional<Segment> clipped_to_sensor(const Segment& s, SensorSize sensor) {
+  if (!s.q0.allFinite() || !s.q1.allFinite()) return std::nullopt;
+  const double x0 = s.q0.x(), y0 = s.q0.y();
+  const double dx = static_cast<double>(s.q1.x()) - x0, dy = static_cast<double>(s.q1.y()) - y0;
+  double t0 = 0, t1 = 1;
+  if (!clip_to_sensor(x0, y0, dx, dy, sensor, t0, t1)) return std::nullopt;
+  return Segment{Point2(static_cast<float>(x0 + t0 * dx), static_cast<float>(y0 + t0 * dy)),
+                 Point2(static_cast<float>(x0 + t1 * dx), static_cast<float>(y0 + t1 * dy))};
+}
+
 void rasterise(std::span<const Segment> segments, SensorSize sensor, std::vector<std::uint8_t>& map) {
   map.assign(pixel_count(sensor), 0);
   for (const Segment& s : segments) {

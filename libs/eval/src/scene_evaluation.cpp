@@ -63,7 +63,7 @@ Timestamp median_step_spacing(std::span<const Timestamp> sorted_times) {
 StreamEvaluator::StreamEvaluator(SensorSize sensor, std::vector<double> tolerance_fractions,
                                  GroundTruthSteps ground_truth, Timestamp hold_us)
     : accuracy_(tolerance_fractions),
-      tracking_(tolerance_fractions.empty() ? 0.0 : diagonal_tolerance_px(sensor, tolerance_fractions.front())),
+      tracking_(sensor, tolerance_fractions.empty() ? 0.0 : diagonal_tolerance_px(sensor, tolerance_fractions.front())),
       ground_truth_(std::move(ground_truth)),
       hold_us_(hold_us),
       counts_(tolerance_fractions.size()) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "evldt/eval/assignment.hpp"
+#include "evldt/eval/line_heatmap.hpp"
 
 namespace evldt {
 
@@ -32,8 +33,11 @@ double ratio(double numerator, double denominator) {
 
 }  // namespace
 
-TrackingEvaluator::TrackingEvaluator(double tolerance_px, double min_overlap)
-    : tolerance_px_(tolerance_px), min_overlap_(min_overlap) {
+TrackingEvaluator::TrackingEvaluator(SensorSize sensor, double tolerance_px, double min_overlap)
+    : sensor_(sensor), tolerance_px_(tolerance_px), min_overlap_(min_overlap) {
+  if (!sensor.valid()) {
+    throw std::invalid_argument("invalid sensor size " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height));
+  }
   if (!std::isfinite(tolerance_px) || tolerance_px < 0) {
     throw std::invalid_argument("tracking tolerance must be finite and >= 0, got " + std::to_string(tolerance_px));
   }
@@ -57,10 +61,13 @@ std::size_t TrackingEvaluator::predicted_index(std::uint64_t id) {
   return index_of_predicted_id_.try_emplace(id, index_of_predicted_id_.size()).first->second;
 }
 
-double TrackingEvaluator::measure_overlaps(const Segment& segment, std::span<const Segment> truth) {
+double TrackingEvaluator::measure_overlaps(const Segment& whole_segment, std::span<const Segment> truth) {
   std::fill(overlap_by_line_.begin(), overlap_by_line_.end(), 0.0);
   std::fill(hit_stamp_.begin(), hit_stamp_.end(), kNoSlot);
-  if (!finite(segment)) return 0;
+  // Clipped first, which also bounds the number of samples whatever a file says.
+  const std::optional<Segment> on_sensor = clipped_to_sensor(whole_segment, sensor_);
+  if (!on_sensor) return 0;
+  const Segment& segment = *on_sensor;
   const double length = segment.length();
   if (!(length > 0)) return 0;
   const double tolerance_squared = tolerance_px_ * tolerance_px_;
@@ -116,7 +123,7 @@ void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> pre
       slot_of_line_[line] = step_lines_.size();
       step_lines_.push_back(line);
     }
-    if (finite(truth[piece])) ground_truth_px_ += truth[piece].length();
+    if (const auto visible = clipped_to_sensor(truth[piece], sensor_)) ground_truth_px_ += visible->length();
   }
   overlap_by_line_.resize(step_lines_.size());
   hit_stamp_.resize(step_lines_.size());

@@ -4,6 +4,7 @@
 // tolerance that is a fraction of the image diagonal. Precision, recall and F follow from the counts.
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -14,6 +15,9 @@ namespace evldt {
 
 /// Largest sampling step along a segment when drawing it, in px.
 inline constexpr double kRasterStepPx = 0.25;
+
+/// The part of a segment on the sensor [0, W] x [0, H], or nothing (also for a non-finite end).
+[[nodiscard]] std::optional<Segment> clipped_to_sensor(const Segment& segment, SensorSize sensor);
 
 /// Draws the segments into a W*H row-major map (resized and cleared here): a pixel is 1 where some
 /// sample of a segment, taken at most kRasterStepPx apart and including both ends, falls in it.

@@ -61,8 +61,9 @@ struct TrackingSummary {
 
 class TrackingEvaluator {
  public:
-  /// Throws std::invalid_argument unless tolerance_px >= 0 and min_overlap is in (0, 1].
-  explicit TrackingEvaluator(double tolerance_px, double min_overlap = kDefaultMinOverlap);
+  /// Segments are measured on the sensor only (clipped to it, as the heat map draws them). Throws
+  /// std::invalid_argument for an invalid sensor, unless tolerance_px >= 0 and min_overlap is in (0, 1].
+  TrackingEvaluator(SensorSize sensor, double tolerance_px, double min_overlap = kDefaultMinOverlap);
 
   /// One step: the prediction in force and the true lines' visible pieces (several pieces may share a
   /// line id). Each id span must be as long as its segment span (else std::invalid_argument). Steps
@@ -83,12 +84,13 @@ class TrackingEvaluator {
     std::uint64_t id = 0;
     double overlap_px = 0;
   };
-  /// The length of `segment` within the tolerance of each line, into overlap_by_line_ (indexed like
-  /// step_lines_), and the segment's length.
+  /// The length of `segment`'s part on the sensor within the tolerance of each line, into
+  /// overlap_by_line_ (indexed like step_lines_); returns the length of that part.
   double measure_overlaps(const Segment& segment, std::span<const Segment> truth);
   std::size_t line_index(std::uint64_t gt_id);
   std::size_t predicted_index(std::uint64_t id);
 
+  SensorSize sensor_;
   double tolerance_px_;
   double min_overlap_;
   std::vector<GroundTruthLineTrack> lines_;
