@@ -287,7 +287,8 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
 int main(int argc, char** argv) {
   CLI::App app{"evldt-eval: line heat-map precision/recall/F (pixels matched one-to-one within a tolerance of the\n"
                "image diagonal, counts summed over steps) and segment lifetimes. Either score a segment CSV\n"
-               "against --ground-truth CSV or a --scene, or run the pipeline on --scene (with --pr-thresholds, once per f_th).\n"
+               "against --ground-truth CSV or a --scene, or run the pipeline on --scene (with --pr-thresholds, once per f_th);\n"
+               "a pipeline run is scored twice: its block segments, and its whole lines (row \"SCENE whole\").\n"
                "Every ground-truth step is scored, against the latest predicted step at or before it within 1.5 output\n"
                "periods, else against nothing (its ground truth counts as missed). Undefined figures print n/a.\n"
                "Tracking, at the first tolerance: a predicted segment matches the true line within the tolerance of at\n"
