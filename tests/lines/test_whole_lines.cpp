@@ -97,6 +97,24 @@ TEST(WholeLineTracker, ALineLostForAMomentComesBackUnderItsIdButNotAfterKeepId) 
   EXPECT_NE(tracker.lines()[0].id, id);
 }
 
+TEST(WholeLineTracker, SegmentsJoinedAtTheLastStepStayJoinedThroughAWobble) {
+  // Ids 1 and 2 along y = 20; then id 2 wobbles by 15 degrees (beyond the 12 of a first join, within
+  // twice that for segments that were one line).
+  const std::vector<TrackedLine> straight = {segment(1, 4, 20, 20, 20), segment(2, 20, 20, 28, 20)};
+  const std::vector<TrackedLine> wobbled = {segment(1, 4, 20, 20, 20), segment(2, 20, 20, 27.73f, 22.07f)};
+  WholeLineTracker first_sight(kBlock);
+  first_sight.update(0, wobbled);
+  EXPECT_EQ(first_sight.lines().size(), 2u);
+  WholeLineTracker tracker(kBlock);
+  tracker.update(0, straight);
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  const std::uint64_t id = tracker.lines()[0].id;
+  tracker.update(10, wobbled);
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.lines()[0].id, id);
+  EXPECT_EQ(tracker.lines()[0].segments, 2u);
+}
+
 TEST(WholeLineTracker, SegmentsAlongACircleDoNotChainIntoOneLine) {
   // 36 chords of a circle of radius 40: neighbours differ by 10 degrees, within the join angle, but
   // the fitted line of a growing chain soon leaves every further chord.

@@ -22,6 +22,7 @@ WholeLineTracker::WholeLineTracker(int block_size, const WholeLineParams& params
       params_(params),
       cell_size_(static_cast<float>(block_size) * std::max(1.0f, params.max_gap_ratio + params.max_offset_ratio)),
       min_cos_angle_(std::cos(params_.max_angle_deg * std::numbers::pi_v<float> / 180.0f)),
+      loose_cos_angle_(std::cos(std::min(90.0f, 2.0f * params_.max_angle_deg) * std::numbers::pi_v<float> / 180.0f)),
       first_id_(first_id),
       next_id_(first_id) {
   if (first_id == kNoId) throw std::invalid_argument("whole-line ids start above 0");
@@ -34,19 +35,20 @@ std::int64_t WholeLineTracker::cell_of(const Point2& p) const {
   return (cy << 32) + cx;
 }
 
-bool WholeLineTracker::fits(const Cluster& cluster, const Segment& segment) const {
+bool WholeLineTracker::fits(const Cluster& cluster, const Segment& segment, bool together_before) const {
   const Point2 along = segment.q1 - segment.q0;
   const float length = along.norm();
   if (!(length > 0)) return false;
-  if (std::abs(along.dot(cluster.direction)) < min_cos_angle_ * length) return false;
-  const float max_offset = params_.max_offset_ratio * block_size_;
+  const float relax = together_before ? 2.0f : 1.0f;
+  if (std::abs(along.dot(cluster.direction)) < (together_before ? loose_cos_angle_ : min_cos_angle_) * length) return false;
+  const float max_offset = relax * params_.max_offset_ratio * block_size_;
   const Point2 a = segment.q0 - cluster.point, b = segment.q1 - cluster.point;
   if (std::abs(cross2(cluster.direction, a)) > max_offset || std::abs(cross2(cluster.direction, b)) > max_offset) {
     return false;
   }
   const float ta = a.dot(cluster.direction), tb = b.dot(cluster.direction);
   const float gap = std::max({std::min(ta, tb) - cluster.t_max, cluster.t_min - std::max(ta, tb), 0.0f});
-  return gap <= params_.max_gap_ratio * block_size_;
+  return gap <= relax * params_.max_gap_ratio * block_size_;
 }
 
 void WholeLineTracker::add_member(Cluster& cluster, std::size_t first, std::span<const TrackedLine> segments) const {
@@ -86,6 +88,11 @@ void WholeLineTracker::add_member(Cluster& cluster, std::size_t first, std::span
       cluster.t_max = std::max(cluster.t_max, t);
     }
   }
+}
+
+std::uint64_t WholeLineTracker::previous_owner(std::uint64_t segment_id) const {
+  const auto it = std::lower_bound(owner_.begin(), owner_.end(), std::pair(segment_id, std::uint64_t{0}));
+  return it != owner_.end() && it->first == segment_id ? it->second : kNoId;
 }
 
 std::size_t WholeLineTracker::find_ended(const Cluster& cluster, Timestamp t) const {
@@ -140,6 +147,7 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     const std::size_t first = members_.size();
     cluster_start_.push_back(first);
     Cluster cluster;
+    const std::uint64_t seed_owner = previous_owner(segments[seed].id);
     cluster_of_segment_[seed] = c;
     members_.push_back(seed);
     add_member(cluster, first, segments);
@@ -155,7 +163,9 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
             auto it = std::lower_bound(grid_.begin(), grid_.end(), std::pair(cell, std::uint32_t{0}));
             for (; it != grid_.end() && it->first == cell; ++it) {
               const std::uint32_t k = it->second;
-              if (cluster_of_segment_[k] != kUnassigned || !fits(cluster, segments[k].segment)) continue;
+              if (cluster_of_segment_[k] != kUnassigned) continue;
+              const std::uint64_t owner = previous_owner(segments[k].id);
+              if (!fits(cluster, segments[k].segment, owner != kNoId && owner == seed_owner)) continue;
               cluster_of_segment_[k] = c;
               members_.push_back(k);
               add_member(cluster, first, segments);

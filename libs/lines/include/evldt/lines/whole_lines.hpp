@@ -48,7 +48,12 @@ class WholeLineTracker {
     double weight = 0, sum_x = 0, sum_y = 0, sum_xx = 0, sum_xy = 0, sum_yy = 0;
   };
   [[nodiscard]] std::int64_t cell_of(const Point2& p) const;
-  [[nodiscard]] bool fits(const Cluster& cluster, const Segment& segment) const;
+  /// together_before: the segment and the cluster's seed belonged to one line at the last step;
+  /// such a pair joins within twice the angle, offset and gap (hysteresis: a line does not split
+  /// for a step's wobble).
+  [[nodiscard]] bool fits(const Cluster& cluster, const Segment& segment, bool together_before) const;
+  /// The whole-line id a segment belonged to at the last step, or 0.
+  [[nodiscard]] std::uint64_t previous_owner(std::uint64_t segment_id) const;
   /// Adds a member's ends to the moments and refits direction and extent over members [first, end).
   void add_member(Cluster& cluster, std::size_t first, std::span<const TrackedLine> segments) const;
   /// The index of the earlier line, ended within keep_id_us, that `cluster` continues, or npos.
@@ -58,6 +63,7 @@ class WholeLineTracker {
   WholeLineParams params_;
   float cell_size_;  ///< of the grid of segment ends
   float min_cos_angle_;
+  float loose_cos_angle_;
   std::uint64_t first_id_;
   std::uint64_t next_id_;
   bool stepped_ = false;
