@@ -322,34 +322,27 @@ TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   EXPECT_EQ(totals.events_received, first.events_published + second.events_published);
   EXPECT_EQ(totals.events_stored, totals.filtered.passed);
 
-  // Ids of the first camera run and of the second never overlap.
-  const auto lists = collector.lists();
-  std::uint64_t max_before = 0, min_after = UINT64_MAX;
-  for (std::size_t i = 0; i < lists.size(); ++i) {
-    for (const auto& segment : lists[i].segments) {
-      const auto id = static_cast<std::uint64_t>(segment.id);
-      if (i < lists_before) max_before = std::max(max_before, id);
-      if (i >= lists_before && lists[i].t_us < lists[lists_before - 1].t_us) min_after = std::min(min_after, id);
+  // Ids of the first camera run and of the second never overlap: the largest id of the lists
+  // before the restart, and the smallest of the new engine's lists (event time gone back).
+  const auto expect_ids_apart = [lists_before](const std::vector<segment_list_t>& lists, std::size_t count) {
+    std::uint64_t max_before = 0, min_after = UINT64_MAX;
+    for (std::size_t i = 0; i < count; ++i) {
+      for (const auto& entry : lists[i].segments) {
+        const auto id = static_cast<std::uint64_t>(entry.id);
+        if (i < lists_before) max_before = std::max(max_before, id);
+        if (i >= lists_before && lists[i].t_us < lists[lists_before - 1].t_us) min_after = std::min(min_after, id);
+      }
     }
-  }
-  ASSERT_GT(max_before, 0u);
-  ASSERT_LT(min_after, UINT64_MAX);
-  EXPECT_GT(min_after, max_before);
-
+    ASSERT_GT(max_before, 0u);
+    ASSERT_LT(min_after, UINT64_MAX);
+    EXPECT_GT(min_after, max_before);
+  };
+  const auto lists = collector.lists();
+  expect_ids_apart(lists, lists.size());
   // So do the whole lines' (a list of them is published with each segment list).
   const auto whole = whole_collector.lists();
   ASSERT_LE(std::max(whole.size(), lists.size()) - std::min(whole.size(), lists.size()), 1u);
-  std::uint64_t whole_max_before = 0, whole_min_after = UINT64_MAX;
-  for (std::size_t i = 0; i < std::min(whole.size(), lists.size()); ++i) {
-    for (const auto& line : whole[i].segments) {
-      const auto id = static_cast<std::uint64_t>(line.id);
-      if (i < lists_before) whole_max_before = std::max(whole_max_before, id);
-      if (i >= lists_before && whole[i].t_us < whole[lists_before - 1].t_us) whole_min_after = std::min(whole_min_after, id);
-    }
-  }
-  ASSERT_GT(whole_max_before, 0u);
-  ASSERT_LT(whole_min_after, UINT64_MAX);
-  EXPECT_GT(whole_min_after, whole_max_before);
+  expect_ids_apart(whole, std::min(whole.size(), lists.size()));
 }
 
 TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {

@@ -53,7 +53,7 @@ fi
 # Whether evldt-lines kept up: 1.5 s of events make 750 tracking rounds of 2 ms. When other work
 # starves it (a noisy shared VM: 420-630 rounds seen), its live output lags and is judged only
 # against a floor; when it keeps up, against the offline run.
-rounds=$(grep -oP 'loops +[0-9]+ detection rounds, \K[0-9]+' "$work/lines.out")
+rounds=$(tracking_rounds "$work/lines.out")
 kept_up=$((${rounds:-0} * 10 >= 750 * 9))
 echo "evldt-lines ran ${rounds:-?} of 750 tracking rounds"
 check "junk counted as 8 invalid messages" grep -q " 8 invalid messages" "$work/lines.out"
@@ -105,7 +105,7 @@ if ((log_complete)); then
   "$eval_tool" --segments "$work/replay.lcm" "${scene[@]}" --json "$work/replay.json" >/dev/null 2>&1
   replay_f=$(f_at_1_percent "$work/replay.json")
   echo "F@1%: replayed $replay_f"
-  replay_rounds=$(grep -oP 'loops +[0-9]+ detection rounds, \K[0-9]+' "$work/replay_lines.out")
+  replay_rounds=$(tracking_rounds "$work/replay_lines.out")
   if ((kept_up && ${replay_rounds:-0} * 10 >= 750 * 9)); then
     check "replayed F@1% within 0.06 of the live run" close_to "$replay_f" "$live_f" 0.06
   else

@@ -68,6 +68,10 @@ log_holds() {  # log_holds URL LOG_FILE CHANNEL COUNT: the log has at least COUN
   "$junk" "$1" TEST_MARKER 1 && test "$("$log_count" "$2" "$3")" -ge "$4"
 }
 
+tracking_rounds() {  # tracking_rounds SUMMARY_FILE: the tracking rounds an evldt-lines summary reports
+  grep -oP 'loops +[0-9]+ detection rounds, \K[0-9]+' "$1"
+}
+
 log_holds_all() {  # log_holds_all URL LOG_FILE CHANNEL COUNT: waits for log_holds, else says how many arrived
   wait_until "$4 messages on $3 in $(basename "$2")" log_holds "$@" && return 0
   echo "  $(basename "$2") holds $("$log_count" "$2" "$3") of $4 messages on $3"

@@ -184,8 +184,8 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   for (std::size_t c = 0; c < count; ++c) {
     for (std::size_t m = cluster_start_[c]; m < cluster_start_[c + 1]; ++m) {
       const TrackedLine& s = segments[members_[m]];
-      const auto it = std::lower_bound(owner_.begin(), owner_.end(), std::pair(s.id, std::uint64_t{0}));
-      if (it != owner_.end() && it->first == s.id) votes_.push_back({c, it->second, s.segment.length()});
+      const std::uint64_t owner = previous_owner(s.id);
+      if (owner != kNoId) votes_.push_back({c, owner, s.segment.length()});
     }
   }
   std::sort(votes_.begin(), votes_.end(), [](const Vote& a, const Vote& b) {
