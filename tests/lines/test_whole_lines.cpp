@@ -10,17 +10,31 @@
 namespace evldt {
 namespace {
 
-constexpr int kBlock = 8;  // default joins: 12 degrees, ends within 4.8 px, gaps up to 16 px
+constexpr int kBlock = 8;  // default joins: 12 degrees, ends within 4.8 px, gaps up to 16 px; published from 24 px
 
 TrackedLine segment(std::uint64_t id, float x0, float y0, float x1, float y1) {
   return {.id = id, .segment = {Point2(x0, y0), Point2(x1, y1)}, .status = LineStatus::GoodTrack};
 }
 
-/// Block segments along y = 20 + dy from x = 4 to 36 (ids 1-4), and a parallel edge 10 px below (id 9).
+/// Block segments along y = 20 + dy from x = 4 to 36 (ids 1-4), and a parallel edge 10 px below
+/// from x = 4 to 28 (ids 9-11).
 std::vector<TrackedLine> edge_pieces(float dy = 0) {
-  return {segment(1, 4, 20 + dy, 12, 20 + dy), segment(2, 12, 20 + dy, 20, 20.5f + dy),
+  return {segment(1, 4, 20 + dy, 12, 20 + dy),   segment(2, 12, 20 + dy, 20, 20.5f + dy),
           segment(3, 20, 20.5f + dy, 28, 20 + dy), segment(4, 28, 20 + dy, 36, 20 + dy),
-          segment(9, 4, 30 + dy, 12, 30 + dy)};
+          segment(9, 4, 30 + dy, 12, 30 + dy),     segment(10, 12, 30 + dy, 20, 30 + dy),
+          segment(11, 20, 30 + dy, 28, 30 + dy)};
+}
+
+/// Segments of 8 px along y = `y` from x0 to x1, ids from first_id.
+std::vector<TrackedLine> pieces_along(float y, float x0, float x1, std::uint64_t first_id) {
+  std::vector<TrackedLine> out;
+  for (float x = x0; x + 8 <= x1 + 0.01f; x += 8) out.push_back(segment(first_id++, x, y, x + 8, y));
+  return out;
+}
+
+std::vector<TrackedLine> operator+(std::vector<TrackedLine> a, const std::vector<TrackedLine>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
 }
 
 const WholeLine& line_holding(const WholeLineTracker& tracker, float y) {
@@ -30,15 +44,42 @@ const WholeLine& line_holding(const WholeLineTracker& tracker, float y) {
   throw std::logic_error("no line there");
 }
 
+float min_x(const WholeLine& l) { return std::min(l.segment.q0.x(), l.segment.q1.x()); }
+float max_x(const WholeLine& l) { return std::max(l.segment.q0.x(), l.segment.q1.x()); }
+
+/// Parameters that publish every line, for tests of the joins alone.
+WholeLineParams publish_all() {
+  WholeLineParams params;
+  params.min_length_ratio = 0;
+  return params;
+}
+
 TEST(WholeLineTracker, JoinsTouchingCollinearSegmentsAndKeepsAParallelEdgeApart) {
   WholeLineTracker tracker(kBlock);
   tracker.update(0, edge_pieces());
   ASSERT_EQ(tracker.lines().size(), 2u);
   const WholeLine& joined = line_holding(tracker, 20.1f);
   EXPECT_EQ(joined.segments, 4u);
-  EXPECT_NEAR(std::min(joined.segment.q0.x(), joined.segment.q1.x()), 4.0f, 0.1f);
-  EXPECT_NEAR(std::max(joined.segment.q0.x(), joined.segment.q1.x()), 36.0f, 0.1f);
-  EXPECT_EQ(line_holding(tracker, 30).segments, 1u);
+  EXPECT_NEAR(min_x(joined), 4.0f, 0.1f);
+  EXPECT_NEAR(max_x(joined), 36.0f, 0.1f);
+  EXPECT_EQ(line_holding(tracker, 30).segments, 3u);
+}
+
+TEST(WholeLineTracker, ShortLinesAreNotPublishedAndTakeNoId) {
+  WholeLineTracker tracker(kBlock);
+  // 16 px and 8 px: both under 3 b.
+  tracker.update(0, pieces_along(20, 4, 20, 1) + pieces_along(60, 4, 12, 5));
+  EXPECT_TRUE(tracker.lines().empty());
+  EXPECT_EQ(tracker.created(), 0u);
+  // The first grows to 24 px: published now, and then while it lasts, also shorter again.
+  tracker.update(10, pieces_along(20, 4, 28, 1));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.lines()[0].first_seen_us, 0);  // its track began before it was published
+  const std::uint64_t id = tracker.lines()[0].id;
+  tracker.update(20, pieces_along(20, 4, 12, 1));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.lines()[0].id, id);
+  EXPECT_EQ(tracker.created(), 1u);
 }
 
 TEST(WholeLineTracker, ALineKeepsItsIdWhileItsSegmentsChange) {
@@ -58,42 +99,156 @@ TEST(WholeLineTracker, ALineKeepsItsIdWhileItsSegmentsChange) {
   EXPECT_EQ(tracker.created(), 2u);
 }
 
+TEST(WholeLineTracker, AnEndItsSegmentsFallShortOfStaysForEndMemory) {
+  WholeLineParams params;
+  params.end_memory_us = 50;
+  WholeLineTracker tracker(kBlock, params);
+  tracker.update(0, pieces_along(20, 4, 52, 1));  // 6 segments, 4..52
+  // The segments at both ends of the edge drop out: the ends stay.
+  tracker.update(10, pieces_along(20, 12, 44, 2));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_NEAR(min_x(tracker.lines()[0]), 4.0f, 0.1f);
+  EXPECT_NEAR(max_x(tracker.lines()[0]), 52.0f, 0.1f);
+  EXPECT_EQ(tracker.lines()[0].segments, 4u);
+  tracker.update(50, pieces_along(20, 12, 44, 2));
+  EXPECT_NEAR(min_x(tracker.lines()[0]), 4.0f, 0.1f);
+  EXPECT_NEAR(max_x(tracker.lines()[0]), 52.0f, 0.1f);
+  // Not reached for longer than end_memory_us: the ends follow the segments.
+  tracker.update(61, pieces_along(20, 12, 44, 2));
+  EXPECT_NEAR(min_x(tracker.lines()[0]), 12.0f, 0.1f);
+  EXPECT_NEAR(max_x(tracker.lines()[0]), 44.0f, 0.1f);
+}
+
+TEST(WholeLineTracker, ARememberedEndDoesNotFollowALineThatTurned) {
+  WholeLineTracker tracker(kBlock);
+  tracker.update(0, pieces_along(20, 4, 52, 1));
+  // What is left turns by 20 degrees (within the twice-as-loose bounds of former members).
+  const float c = std::cos(20.0f * std::numbers::pi_v<float> / 180), s = std::sin(20.0f * std::numbers::pi_v<float> / 180);
+  std::vector<TrackedLine> turned;
+  for (std::uint64_t k = 0; k < 3; ++k) {
+    const float x0 = 4 + 8.0f * static_cast<float>(k) * c, y0 = 20 + 8.0f * static_cast<float>(k) * s;
+    turned.push_back(segment(k + 1, x0, y0, x0 + 8 * c, y0 + 8 * s));
+  }
+  tracker.update(10, turned);
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_NEAR(tracker.lines()[0].segment.length(), 24.0f, 0.1f);
+}
+
 TEST(WholeLineTracker, OfASplitLineTheLongerPartKeepsTheId) {
   WholeLineTracker tracker(kBlock);
-  const std::vector<TrackedLine> whole = {segment(1, 4, 20, 12, 20), segment(2, 12, 20, 20, 20),
-                                          segment(3, 20, 20, 28, 20), segment(4, 28, 20, 36, 20),
-                                          segment(5, 36, 20, 44, 20)};
-  tracker.update(0, whole);
+  tracker.update(0, pieces_along(20, 4, 68, 1));  // ids 1-8
   ASSERT_EQ(tracker.lines().size(), 1u);
   const std::uint64_t id = tracker.lines()[0].id;
-  // The middle piece turns away (an occluder's edge) and the right part now starts 24 px on, more
-  // than the 16 px gap a line may bridge; the left part (20 px) is longer than the right (16 px).
-  const std::vector<TrackedLine> split = {segment(1, 0, 20, 12, 20), whole[1], segment(3, 20, 20, 26, 28),
-                                          segment(4, 44, 20, 52, 20), segment(5, 52, 20, 60, 20)};
+  // The middle turns away (an occluder's edge) and the right part now starts 40 px on, more than
+  // even the 32 px gap a line's own segments may bridge; the left part (32 px) is longer than the
+  // right (24 px).
+  const std::vector<TrackedLine> split = pieces_along(20, 4, 36, 1) + std::vector{segment(5, 36, 20, 42, 28)} +
+                                         pieces_along(20, 76, 100, 6);
   tracker.update(10, split);
-  EXPECT_EQ(line_holding(tracker, 20).id, id);
-  std::size_t with_old_id = 0;
-  for (const WholeLine& l : tracker.lines()) with_old_id += l.id == id ? 1 : 0;
-  EXPECT_EQ(with_old_id, 1u);
-  EXPECT_EQ(tracker.lines().size(), 3u);
+  ASSERT_EQ(tracker.lines().size(), 2u);
   for (const WholeLine& l : tracker.lines()) {
-    if (l.id == id) EXPECT_LT(l.segment.centre().x(), 20.0f);
+    if (l.id == id) {
+      EXPECT_NEAR(min_x(l), 4.0f, 0.1f);
+    } else {
+      EXPECT_NEAR(min_x(l), 76.0f, 0.1f);
+    }
   }
+  EXPECT_EQ(tracker.created(), 2u);
+}
+
+TEST(WholeLineTracker, OfTwoLinesThatGrowTogetherTheOneFirstPublishedKeepsItsId) {
+  WholeLineTracker tracker(kBlock);
+  tracker.update(0, pieces_along(20, 4, 36, 1));
+  const std::uint64_t first = tracker.lines()[0].id;
+  // A second line further along the edge, 24 px beyond the first's end.
+  tracker.update(10, pieces_along(20, 4, 36, 1) + pieces_along(20, 60, 92, 11));
+  ASSERT_EQ(tracker.lines().size(), 2u);
+  // The segments between appear: one line, under the first id.
+  tracker.update(20, pieces_along(20, 4, 36, 1) + pieces_along(20, 44, 52, 21) + pieces_along(20, 60, 92, 11));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.lines()[0].id, first);
+  EXPECT_NEAR(max_x(tracker.lines()[0]), 92.0f, 0.1f);
+}
+
+TEST(WholeLineTracker, APublishedLineKeepsItsIdWhenItMergesWithAnOlderUnpublishedOne) {
+  WholeLineTracker tracker(kBlock);
+  tracker.update(0, pieces_along(20, 60, 76, 11));  // 16 px: tracked, not published
+  EXPECT_TRUE(tracker.lines().empty());
+  tracker.update(10, pieces_along(20, 60, 76, 11) + pieces_along(20, 4, 36, 1));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  const std::uint64_t published = tracker.lines()[0].id;
+  tracker.update(20, pieces_along(20, 60, 76, 11) + pieces_along(20, 4, 36, 1) + pieces_along(20, 44, 52, 21));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.lines()[0].id, published);
+  EXPECT_NEAR(max_x(tracker.lines()[0]), 76.0f, 0.1f);
+  EXPECT_EQ(tracker.created(), 1u);
+}
+
+TEST(WholeLineTracker, ASecondLineAlongAPublishedOneIsNotPublished) {
+  WholeLineTracker tracker(kBlock);
+  tracker.update(0, pieces_along(20, 4, 68, 1));
+  // New segments 6 px off the line (beyond the 4.8 px a new segment may be off it, within twice
+  // that), along its length: a line of their own, shadowed by the published one.
+  tracker.update(10, pieces_along(20, 4, 68, 1) + pieces_along(26, 12, 44, 21));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.created(), 1u);
+}
+
+TEST(WholeLineTracker, LinesWhoseEndsFallShortOfACornerMeetThere) {
+  WholeLineTracker tracker(kBlock);
+  // An L: a horizontal edge y = 20 ending at x = 40 and a vertical edge x = 50 starting at y = 30;
+  // the corner (50, 20) lies 10 px from each end (within 2 b).
+  std::vector<TrackedLine> corner = pieces_along(20, 8, 40, 1);
+  for (std::uint64_t k = 0; k < 4; ++k) {
+    corner.push_back(segment(11 + k, 50, 30 + 8.0f * static_cast<float>(k), 50, 38 + 8.0f * static_cast<float>(k)));
+  }
+  // Far from both (a corner 20 px off the nearest end): left alone.
+  for (std::uint64_t k = 0; k < 4; ++k) {
+    corner.push_back(segment(21 + k, 100, 40 + 8.0f * static_cast<float>(k), 100, 48 + 8.0f * static_cast<float>(k)));
+  }
+  tracker.update(0, corner);
+  ASSERT_EQ(tracker.lines().size(), 3u);
+  const WholeLine& horizontal = line_holding(tracker, 20);
+  EXPECT_NEAR(max_x(horizontal), 50.0f, 0.01f);
+  EXPECT_NEAR(min_x(horizontal), 8.0f, 0.01f);
+  for (const WholeLine& l : tracker.lines()) {
+    if (std::abs(l.segment.centre().x() - 50) < 1) {
+      EXPECT_NEAR(std::min(l.segment.q0.y(), l.segment.q1.y()), 20.0f, 0.01f);
+    } else if (std::abs(l.segment.centre().x() - 100) < 1) {
+      EXPECT_NEAR(std::min(l.segment.q0.y(), l.segment.q1.y()), 40.0f, 0.01f);
+    }
+  }
+  // Nearly parallel lines make no corner: a line at 20 degrees to the horizontal one, its end 8 px on.
+  const float c = std::cos(20.0f * std::numbers::pi_v<float> / 180), s = std::sin(20.0f * std::numbers::pi_v<float> / 180);
+  std::vector<TrackedLine> lines = pieces_along(20, 8, 40, 1);
+  for (std::uint64_t k = 0; k < 4; ++k) {
+    const float x0 = 48 + 8.0f * static_cast<float>(k) * c, y0 = 20 + 8.0f * static_cast<float>(k) * s;
+    lines.push_back(segment(11 + k, x0, y0, x0 + 8 * c, y0 + 8 * s));
+  }
+  WholeLineParams steep;
+  steep.corner_min_angle_deg = 30;
+  WholeLineTracker tracker_steep(kBlock, steep);
+  tracker_steep.update(0, lines);
+  ASSERT_EQ(tracker_steep.lines().size(), 2u);
+  EXPECT_NEAR(max_x(line_holding(tracker_steep, 20)), 40.0f, 0.01f);
 }
 
 TEST(WholeLineTracker, ALineLostForAMomentComesBackUnderItsIdButNotAfterKeepId) {
-  WholeLineTracker tracker(kBlock);
-  const std::vector<TrackedLine> edge = {segment(1, 4, 20, 12, 20), segment(2, 12, 20, 20, 20)};
-  tracker.update(0, edge);
+  WholeLineParams params;
+  params.keep_id_us = 100'000;
+  WholeLineTracker tracker(kBlock, params);
+  tracker.update(0, pieces_along(20, 4, 36, 1));
   const std::uint64_t id = tracker.lines()[0].id;
   tracker.update(50'000, {});
-  // New segment ids along the same stretch: taken up by geometry within keep_id_us.
-  tracker.update(100'000, std::vector<TrackedLine>{segment(11, 5, 21, 13, 21), segment(12, 13, 21, 21, 21)});
+  EXPECT_TRUE(tracker.lines().empty());
+  // New segment ids along the same stretch, 1 px off: taken up by geometry within keep_id_us.
+  tracker.update(100'000, pieces_along(21, 5, 37, 11));
   ASSERT_EQ(tracker.lines().size(), 1u);
   EXPECT_EQ(tracker.lines()[0].id, id);
   EXPECT_EQ(tracker.lines()[0].first_seen_us, 0);
   tracker.update(150'000, {});
-  tracker.update(200'001, std::vector<TrackedLine>{segment(21, 5, 21, 13, 21)});
+  tracker.update(200'001, pieces_along(21, 5, 37, 21));
+  ASSERT_EQ(tracker.lines().size(), 1u);
   EXPECT_NE(tracker.lines()[0].id, id);
 }
 
@@ -102,10 +257,10 @@ TEST(WholeLineTracker, SegmentsJoinedAtTheLastStepStayJoinedThroughAWobble) {
   // twice that for segments that were one line).
   const std::vector<TrackedLine> straight = {segment(1, 4, 20, 20, 20), segment(2, 20, 20, 28, 20)};
   const std::vector<TrackedLine> wobbled = {segment(1, 4, 20, 20, 20), segment(2, 20, 20, 27.73f, 22.07f)};
-  WholeLineTracker first_sight(kBlock);
+  WholeLineTracker first_sight(kBlock, publish_all());
   first_sight.update(0, wobbled);
   EXPECT_EQ(first_sight.lines().size(), 2u);
-  WholeLineTracker tracker(kBlock);
+  WholeLineTracker tracker(kBlock, publish_all());
   tracker.update(0, straight);
   ASSERT_EQ(tracker.lines().size(), 1u);
   const std::uint64_t id = tracker.lines()[0].id;
@@ -124,7 +279,9 @@ TEST(WholeLineTracker, SegmentsAlongACircleDoNotChainIntoOneLine) {
     chords.push_back(segment(static_cast<std::uint64_t>(k + 1), 60 + 40 * std::cos(a0), 60 + 40 * std::sin(a0),
                              60 + 40 * std::cos(a1), 60 + 40 * std::sin(a1)));
   }
-  WholeLineTracker tracker(kBlock);
+  WholeLineParams params = publish_all();
+  params.corner_reach_ratio = 0;  // neighbouring chords meet anyway
+  WholeLineTracker tracker(kBlock, params);
   tracker.update(0, chords);
   EXPECT_GE(tracker.lines().size(), 12u);
   for (const WholeLine& l : tracker.lines()) EXPECT_LE(l.segments, 3u);

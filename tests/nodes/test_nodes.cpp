@@ -176,12 +176,14 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
   EXPECT_GE(most_segments, 10u);  // boxes-6dof shows some 20 edges
 
   // Whole lines: one list per segment list, published with it; each joins segments of that list
-  // (its score counts them), and a line keeps its id while it lasts.
+  // (its score counts them; lines too short to publish hold the rest), and a line keeps its id
+  // while it lasts.
   // (LCM may hand over the last one of either kind after the snapshots above.)
   const auto whole = whole_collector.lists();
   ASSERT_LE(std::max(whole.size(), lists.size()) - std::min(whole.size(), lists.size()), 1u);
   EXPECT_EQ(whole_collector.invalid(), 0);
   std::size_t fewer = 0, continued = 0;
+  double joined_segments = 0, all_segments = 0;
   std::set<std::uint64_t> previous_ids;
   const std::size_t both = std::min(whole.size(), lists.size());
   for (std::size_t k = 0; k < both; ++k) {
@@ -197,12 +199,15 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
       ids.insert(line.id);
       continued += previous_ids.count(line.id);
     }
-    EXPECT_EQ(segments, static_cast<double>(lists[k].segments.size()));
+    EXPECT_LE(segments, static_cast<double>(lists[k].segments.size()));
+    joined_segments += segments;
+    all_segments += static_cast<double>(lists[k].segments.size());
     fewer += joined.size() < lists[k].segments.size() ? 1 : 0;
     previous_ids = ids;
   }
   EXPECT_GT(fewer, both / 2);  // segments along one edge are joined
   EXPECT_GT(continued, both);  // ids carry over from list to list
+  EXPECT_GT(joined_segments, 0.6 * all_segments);  // most segments lie along published lines
 }
 
 // Every statistics message a service publishes.

@@ -57,6 +57,17 @@ void PipelineOptions::add_to(CLI::App& app) {
       ->check(finite_number() & CLI::Range(0.0, 16.0));
   group->add_option("--whole-line-keep-id-us", whole_keep_id_, "Whole lines: a line unseen this long gives up its id")
       ->check(CLI::Range(Timestamp{0}, Timestamp{10'000'000}));
+  group->add_option("--whole-line-end-memory-us", whole_end_memory_,
+                    "Whole lines: an end its segments no longer reach stays this long")
+      ->check(CLI::Range(Timestamp{0}, Timestamp{10'000'000}));
+  group->add_option("--whole-line-min-length", whole_min_length_,
+                    "Whole lines: a line is published once it is this many b long (then while it lasts)")
+      ->check(finite_number() & CLI::Range(0.0, 1000.0));
+  group->add_option("--whole-line-corner-reach", whole_corner_reach_,
+                    "Whole lines: two lines whose ends lie within this many b of where they cross meet there (0: off)")
+      ->check(finite_number() & CLI::Range(0.0, 16.0));
+  group->add_option("--whole-line-corner-min-angle", whole_corner_angle_, "... if they differ in direction by this much (degrees)")
+      ->check(finite_number() & CLI::Range(0.0, 90.0));
   group->add_option("--multi-block-norm", multi_block_norm_, "r_e divisor for lines over k blocks: block (N) or union (k*N)")
       ->check(CLI::IsMember({"block", "union"}));
   group->add_option("--track-period-us", track_period_, "Deterministic mode: tracking period in event time")
@@ -111,6 +122,10 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   if (whole_offset_) config.whole_lines.max_offset_ratio = *whole_offset_;
   if (whole_gap_) config.whole_lines.max_gap_ratio = *whole_gap_;
   if (whole_keep_id_) config.whole_lines.keep_id_us = *whole_keep_id_;
+  if (whole_end_memory_) config.whole_lines.end_memory_us = *whole_end_memory_;
+  if (whole_min_length_) config.whole_lines.min_length_ratio = *whole_min_length_;
+  if (whole_corner_reach_) config.whole_lines.corner_reach_ratio = *whole_corner_reach_;
+  if (whole_corner_angle_) config.whole_lines.corner_min_angle_deg = *whole_corner_angle_;
   if (multi_block_norm_) {
     config.track.multi_block_norm = *multi_block_norm_ == "union" ? EffectiveRatioNorm::Union : EffectiveRatioNorm::Block;
   }

@@ -6,14 +6,16 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 namespace evldt {
 
 namespace {
 
 constexpr std::uint32_t kUnassigned = std::numeric_limits<std::uint32_t>::max();
-constexpr std::uint64_t kNoId = 0;
+constexpr std::uint64_t kNoKey = 0;
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+constexpr float kLooseJoin = 2.0f;  // hysteresis: bounds for segments that were already one line
 
 }  // namespace
 
@@ -22,10 +24,11 @@ WholeLineTracker::WholeLineTracker(int block_size, const WholeLineParams& params
       params_(params),
       cell_size_(static_cast<float>(block_size) * std::max(1.0f, params.max_gap_ratio + params.max_offset_ratio)),
       min_cos_angle_(std::cos(params_.max_angle_deg * std::numbers::pi_v<float> / 180.0f)),
-      loose_cos_angle_(std::cos(std::min(90.0f, 2.0f * params_.max_angle_deg) * std::numbers::pi_v<float> / 180.0f)),
+      loose_cos_angle_(
+          std::cos(std::min(90.0f, kLooseJoin * params_.max_angle_deg) * std::numbers::pi_v<float> / 180.0f)),
       first_id_(first_id),
       next_id_(first_id) {
-  if (first_id == kNoId) throw std::invalid_argument("whole-line ids start above 0");
+  if (first_id == 0) throw std::invalid_argument("whole-line ids start above 0");
   if (block_size <= 0) throw std::invalid_argument("whole lines need a positive block size, got " + std::to_string(block_size));
 }
 
@@ -35,26 +38,33 @@ std::int64_t WholeLineTracker::cell_of(const Point2& p) const {
   return (cy << 32) + cx;
 }
 
-bool WholeLineTracker::fits(const Cluster& cluster, const Segment& segment, bool together_before) const {
+bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float relax) const {
   const Point2 along = segment.q1 - segment.q0;
   const float length = along.norm();
   if (!(length > 0)) return false;
-  const float relax = together_before ? 2.0f : 1.0f;
-  if (std::abs(along.dot(cluster.direction)) < (together_before ? loose_cos_angle_ : min_cos_angle_) * length) return false;
+  const float min_cos = relax > 1.0f ? loose_cos_angle_ : min_cos_angle_;
+  if (std::abs(along.dot(line.direction)) < min_cos * length) return false;
   const float max_offset = relax * params_.max_offset_ratio * block_size_;
-  const Point2 a = segment.q0 - cluster.point, b = segment.q1 - cluster.point;
-  if (std::abs(cross2(cluster.direction, a)) > max_offset || std::abs(cross2(cluster.direction, b)) > max_offset) {
+  const Point2 a = segment.q0 - line.point, b = segment.q1 - line.point;
+  if (std::abs(cross2(line.direction, a)) > max_offset || std::abs(cross2(line.direction, b)) > max_offset) {
     return false;
   }
-  const float ta = a.dot(cluster.direction), tb = b.dot(cluster.direction);
-  const float gap = std::max({std::min(ta, tb) - cluster.t_max, cluster.t_min - std::max(ta, tb), 0.0f});
+  const float ta = a.dot(line.direction), tb = b.dot(line.direction);
+  const float gap = std::max({std::min(ta, tb) - line.t_max, line.t_min - std::max(ta, tb), 0.0f});
   return gap <= relax * params_.max_gap_ratio * block_size_;
 }
 
-void WholeLineTracker::add_member(Cluster& cluster, std::size_t first, std::span<const TrackedLine> segments) const {
-  const Segment& s = segments[members_.back()].segment;
-  const double half = 0.5 * static_cast<double>(s.length());
-  for (const Point2& p : {s.q0, s.q1}) {
+std::uint64_t WholeLineTracker::previous_owner(std::uint64_t segment_id) const {
+  const auto it = std::lower_bound(owner_.begin(), owner_.end(), std::pair(segment_id, std::uint64_t{0}));
+  return it != owner_.end() && it->first == segment_id ? it->second : kNoKey;
+}
+
+void WholeLineTracker::add_member(Cluster& cluster, std::uint32_t s, std::span<const TrackedLine> segments) {
+  cluster_of_segment_[s] = static_cast<std::uint32_t>(clusters_.size());
+  members_.push_back(s);
+  const Segment& segment = segments[s].segment;
+  const double half = 0.5 * static_cast<double>(segment.length());
+  for (const Point2& p : {segment.q0, segment.q1}) {
     const double x = p.x(), y = p.y();
     cluster.weight += half;
     cluster.sum_x += half * x;
@@ -67,54 +77,164 @@ void WholeLineTracker::add_member(Cluster& cluster, std::size_t first, std::span
   const double cxx = cluster.sum_xx / cluster.weight - mx * mx;
   const double cxy = cluster.sum_xy / cluster.weight - mx * my;
   const double cyy = cluster.sum_yy / cluster.weight - my * my;
-  // Principal axis of the ends; kept pointing the way it pointed, so extents keep their sign.
+  // Principal axis of the ends; kept pointing the way the line pointed, so its ends keep their sides.
   const double angle = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);
   Point2 direction(static_cast<float>(std::cos(angle)), static_cast<float>(std::sin(angle)));
-  if (first + 1 == members_.size()) {
-    const Point2 along = s.q1 - s.q0;
-    if (direction.dot(along) < 0) direction = -direction;
-  } else if (direction.dot(cluster.direction) < 0) {
-    direction = -direction;
-  }
-  cluster.direction = direction;
-  cluster.point = Point2(static_cast<float>(mx), static_cast<float>(my));
-  cluster.t_min = std::numeric_limits<float>::max();
-  cluster.t_max = std::numeric_limits<float>::lowest();
-  for (std::size_t m = first; m < members_.size(); ++m) {
+  if (direction.dot(cluster.model.direction) < 0) direction = -direction;
+  LineModel& model = cluster.model;
+  model.direction = direction;
+  model.point = Point2(static_cast<float>(mx), static_cast<float>(my));
+  model.t_min = std::numeric_limits<float>::max();
+  model.t_max = std::numeric_limits<float>::lowest();
+  for (std::size_t m = cluster.first_member; m < members_.size(); ++m) {
     const Segment& member = segments[members_[m]].segment;
     for (const Point2& p : {member.q0, member.q1}) {
-      const float t = (p - cluster.point).dot(direction);
-      cluster.t_min = std::min(cluster.t_min, t);
-      cluster.t_max = std::max(cluster.t_max, t);
+      const float t = (p - model.point).dot(direction);
+      model.t_min = std::min(model.t_min, t);
+      model.t_max = std::max(model.t_max, t);
     }
   }
 }
 
-std::uint64_t WholeLineTracker::previous_owner(std::uint64_t segment_id) const {
-  const auto it = std::lower_bound(owner_.begin(), owner_.end(), std::pair(segment_id, std::uint64_t{0}));
-  return it != owner_.end() && it->first == segment_id ? it->second : kNoId;
+void WholeLineTracker::grow(Cluster& cluster, std::uint64_t owner, std::span<const TrackedLine> segments) {
+  // Candidates are segments with an end in the 3 x 3 cells around an end of a member; a cell is as
+  // wide as the gap and offset allowed, so no candidate is missed.
+  for (std::size_t next = cluster.first_member; next < members_.size(); ++next) {
+    const Segment& s = segments[members_[next]].segment;
+    for (const Point2& end : {s.q0, s.q1}) {
+      const std::int64_t centre = cell_of(end);
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+          const std::int64_t cell = centre + (dy << 32) + dx;
+          auto it = std::lower_bound(grid_.begin(), grid_.end(), std::pair(cell, std::uint32_t{0}));
+          for (; it != grid_.end() && it->first == cell; ++it) {
+            const std::uint32_t k = it->second;
+            if (cluster_of_segment_[k] != kUnassigned) continue;
+            const bool was_member = owner != kNoKey && previous_owner(segments[k].id) == owner;
+            if (!fits(cluster.model, segments[k].segment, was_member ? kLooseJoin : 1.0f)) continue;
+            add_member(cluster, k, segments);
+          }
+        }
+      }
+    }
+  }
 }
 
-std::size_t WholeLineTracker::find_ended(const Cluster& cluster, Timestamp t) const {
-  const float max_offset = 0.5f * block_size_;
-  std::size_t best = kNone;
-  float best_offset = 0;
-  for (std::size_t e = 0; e < ended_.size(); ++e) {
-    const WholeLine& earlier = ended_[e];
-    if (earlier.id == kNoId || t - earlier.last_seen_us > params_.keep_id_us) continue;
-    const Point2 along = earlier.segment.q1 - earlier.segment.q0;
-    const float length = along.norm();
-    if (!(length > 0) || std::abs(along.dot(cluster.direction)) < min_cos_angle_ * length) continue;
-    const Point2 centre = earlier.segment.centre() - cluster.point;
-    const float offset = std::abs(cross2(cluster.direction, centre));
-    const float ta = (earlier.segment.q0 - cluster.point).dot(cluster.direction);
-    const float tb = (earlier.segment.q1 - cluster.point).dot(cluster.direction);
-    const bool overlaps = std::max(ta, tb) >= cluster.t_min && std::min(ta, tb) <= cluster.t_max;
-    if (offset > max_offset || !overlaps || (best != kNone && offset >= best_offset)) continue;
-    best = e;
-    best_offset = offset;
+std::size_t WholeLineTracker::first_fit_along(const LineModel& line, std::span<const TrackedLine> segments) const {
+  const float length = line.t_max - line.t_min;
+  const int samples = 1 + static_cast<int>(std::ceil(length / cell_size_));
+  for (int i = 0; i <= samples; ++i) {
+    const Point2 at = line.point + (line.t_min + length * static_cast<float>(i) / static_cast<float>(samples)) * line.direction;
+    const std::int64_t centre = cell_of(at);
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const std::int64_t cell = centre + (dy << 32) + dx;
+        auto it = std::lower_bound(grid_.begin(), grid_.end(), std::pair(cell, std::uint32_t{0}));
+        for (; it != grid_.end() && it->first == cell; ++it) {
+          if (cluster_of_segment_[it->second] == kUnassigned && fits(line, segments[it->second].segment, kLooseJoin)) {
+            return it->second;
+          }
+        }
+      }
+    }
   }
-  return best;
+  return kNone;
+}
+
+void WholeLineTracker::continue_track(Track& track, const Cluster& cluster, std::uint32_t members, Timestamp t) const {
+  LineModel next = cluster.model;
+  // Where the ends were, on the new line: an end the segments fall short of stays for end_memory_us.
+  const LineModel& before = track.model;
+  const float was_min = (before.point + before.t_min * before.direction - next.point).dot(next.direction);
+  const float was_max = (before.point + before.t_max * before.direction - next.point).dot(next.direction);
+  // Only while the line itself is where it was: a line that turned or moved has no ends to keep.
+  const Segment was{before.point + before.t_min * before.direction, before.point + before.t_max * before.direction};
+  const bool same_line = fits({next.point, next.direction, was_min, was_max}, was, 1.0f);
+  const float reach = 0.5f * block_size_;
+  const bool remember_min =
+      same_line && next.t_min > was_min + reach && t - track.end_seen_us[0] <= params_.end_memory_us;
+  const bool remember_max =
+      same_line && next.t_max < was_max - reach && t - track.end_seen_us[1] <= params_.end_memory_us;
+  if (remember_min) {
+    next.t_min = was_min;
+  } else {
+    track.end_seen_us[0] = t;
+  }
+  if (remember_max) {
+    next.t_max = was_max;
+  } else {
+    track.end_seen_us[1] = t;
+  }
+  track.model = next;
+  track.last_seen_us = t;
+  track.segments = members;
+}
+
+bool WholeLineTracker::shadowed(const Segment& segment) const {
+  return std::any_of(published_.begin(), published_.end(), [&](const WholeLine& line) {
+    const Point2 along = line.segment.q1 - line.segment.q0;
+    const float length = along.norm();
+    if (!(length > 0)) return false;
+    const Point2 direction = along / length;
+    if (!fits({line.segment.q0, direction, 0.0f, length}, segment, kLooseJoin)) return false;
+    // ... and covers at least half of it.
+    const float ta = (segment.q0 - line.segment.q0).dot(direction), tb = (segment.q1 - line.segment.q0).dot(direction);
+    const float covered = std::min(std::max(ta, tb), length) - std::max(std::min(ta, tb), 0.0f);
+    return 2.0f * covered >= std::abs(tb - ta);
+  });
+}
+
+void WholeLineTracker::meet_at_corners() {
+  const float reach = params_.corner_reach_ratio * block_size_;
+  if (!(reach > 0) || published_.size() < 2) return;
+  const float min_sin = std::sin(params_.corner_min_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  // Two ends within reach of one corner are within 2 reach of each other: cells that wide, 3 x 3 of them.
+  const float cell = 2.0f * reach;
+  const auto cell_at = [cell](const Point2& p) {
+    return (static_cast<std::int64_t>(std::floor(p.y() / cell)) << 32) + static_cast<std::int64_t>(std::floor(p.x() / cell));
+  };
+  const auto end_point = [&](std::uint32_t end) -> Point2& {
+    Segment& s = published_[end / 2].segment;
+    return end % 2 == 0 ? s.q0 : s.q1;
+  };
+  end_grid_.clear();
+  for (std::uint32_t end = 0; end < 2 * published_.size(); ++end) end_grid_.emplace_back(cell_at(end_point(end)), end);
+  std::sort(end_grid_.begin(), end_grid_.end());
+  corners_.clear();
+  for (std::uint32_t a = 0; a < 2 * published_.size(); ++a) {
+    const Segment& line_a = published_[a / 2].segment;
+    const Point2 pa = end_point(a), da = (line_a.q1 - line_a.q0).normalized();
+    const std::int64_t centre = cell_at(pa);
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const std::int64_t c = centre + (dy << 32) + dx;
+        auto it = std::lower_bound(end_grid_.begin(), end_grid_.end(), std::pair(c, std::uint32_t{0}));
+        for (; it != end_grid_.end() && it->first == c; ++it) {
+          const std::uint32_t b = it->second;
+          if (b / 2 <= a / 2) continue;  // each pair of lines once, never a line with itself
+          const Segment& line_b = published_[b / 2].segment;
+          const Point2 pb = end_point(b), db = (line_b.q1 - line_b.q0).normalized();
+          const float sine = cross2(da, db);
+          if (std::abs(sine) < min_sin) continue;
+          const Point2 at = pa + (cross2(pb - pa, db) / sine) * da;
+          const float cost = (at - pa).norm() + (at - pb).norm();
+          if ((at - pa).norm() > reach || (at - pb).norm() > reach) continue;
+          corners_.push_back({cost, a, b, at});
+        }
+      }
+    }
+  }
+  // Nearest corners first; an end meets one corner.
+  std::sort(corners_.begin(), corners_.end(), [](const Corner& x, const Corner& y) {
+    return x.cost != y.cost ? x.cost < y.cost : std::pair(x.end_a, x.end_b) < std::pair(y.end_a, y.end_b);
+  });
+  end_moved_.assign(2 * published_.size(), 0);
+  for (const Corner& corner : corners_) {
+    if (end_moved_[corner.end_a] != 0 || end_moved_[corner.end_b] != 0) continue;
+    end_moved_[corner.end_a] = end_moved_[corner.end_b] = 1;
+    end_point(corner.end_a) = corner.at;
+    end_point(corner.end_b) = corner.at;
+  }
 }
 
 void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments) {
@@ -124,134 +244,121 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   const auto n = static_cast<std::uint32_t>(segments.size());
 
   grid_.clear();
+  owned_.clear();
   for (std::uint32_t i = 0; i < n; ++i) {
     grid_.emplace_back(cell_of(segments[i].segment.q0), i);
     grid_.emplace_back(cell_of(segments[i].segment.q1), i);
+    const std::uint64_t owner = previous_owner(segments[i].id);
+    if (owner != kNoKey) owned_.emplace_back(owner, i);
   }
   std::sort(grid_.begin(), grid_.end());
-  // Longest segments seed lines first, so a line's direction comes from its best evidence.
-  order_.resize(n);
-  for (std::uint32_t i = 0; i < n; ++i) order_[i] = i;
-  std::sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
+  // Longest segments first, of a line's former segments and of new lines' seeds, so a line's direction
+  // comes from its best evidence.
+  const auto longer = [&](std::uint32_t a, std::uint32_t b) {
     const float la = segments[a].segment.length(), lb = segments[b].segment.length();
     return la != lb ? la > lb : segments[a].id < segments[b].id;
+  };
+  std::sort(owned_.begin(), owned_.end(), [&](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first < b.first : longer(a.second, b.second);
   });
+  order_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) order_[i] = i;
+  std::sort(order_.begin(), order_.end(), longer);
 
   cluster_of_segment_.assign(n, kUnassigned);
   clusters_.clear();
-  cluster_start_.clear();
+  track_of_cluster_.clear();
   members_.clear();
-  for (const std::uint32_t seed : order_) {
-    if (cluster_of_segment_[seed] != kUnassigned || !(segments[seed].segment.length() > 0)) continue;
-    const auto c = static_cast<std::uint32_t>(clusters_.size());
-    const std::size_t first = members_.size();
-    cluster_start_.push_back(first);
+  // Lines tracked so far, oldest first: the older line wins a contested segment and keeps its id.
+  for (std::size_t k = 0; k < tracks_.size(); ++k) {
+    const Track& track = tracks_[k];
+    if (t - track.last_seen_us > params_.keep_id_us) continue;
     Cluster cluster;
-    const std::uint64_t seed_owner = previous_owner(segments[seed].id);
-    cluster_of_segment_[seed] = c;
-    members_.push_back(seed);
-    add_member(cluster, first, segments);
-    // Grow along the edge: candidates are segments with an end in the 3 x 3 cells around an end of a
-    // member; a cell is as wide as the gap and offset allowed, so no candidate is missed.
-    for (std::size_t next = first; next < members_.size(); ++next) {
-      const Segment& s = segments[members_[next]].segment;
-      for (const Point2& end : {s.q0, s.q1}) {
-        const std::int64_t centre = cell_of(end);
-        for (std::int64_t dy = -1; dy <= 1; ++dy) {
-          for (std::int64_t dx = -1; dx <= 1; ++dx) {
-            const std::int64_t cell = centre + (dy << 32) + dx;
-            auto it = std::lower_bound(grid_.begin(), grid_.end(), std::pair(cell, std::uint32_t{0}));
-            for (; it != grid_.end() && it->first == cell; ++it) {
-              const std::uint32_t k = it->second;
-              if (cluster_of_segment_[k] != kUnassigned) continue;
-              const std::uint64_t owner = previous_owner(segments[k].id);
-              if (!fits(cluster, segments[k].segment, owner != kNoId && owner == seed_owner)) continue;
-              cluster_of_segment_[k] = c;
-              members_.push_back(k);
-              add_member(cluster, first, segments);
-            }
-          }
-        }
+    cluster.model = track.model;
+    cluster.first_member = members_.size();
+    auto it = std::lower_bound(owned_.begin(), owned_.end(), std::pair(track.key, std::uint32_t{0}),
+                               [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (; it != owned_.end() && it->first == track.key; ++it) {
+      if (cluster_of_segment_[it->second] == kUnassigned && fits(cluster.model, segments[it->second].segment, kLooseJoin)) {
+        add_member(cluster, it->second, segments);
       }
     }
+    if (members_.size() == cluster.first_member) {
+      const std::size_t found = first_fit_along(track.model, segments);
+      if (found == kNone) continue;  // waits, under its last geometry
+      add_member(cluster, static_cast<std::uint32_t>(found), segments);
+    }
+    grow(cluster, track.key, segments);
     clusters_.push_back(cluster);
+    track_of_cluster_.push_back(k);
   }
-  cluster_start_.push_back(members_.size());
-  const std::size_t count = clusters_.size();
-
-  // Ids: each earlier line goes to the new line holding most of its segments' length.
-  votes_.clear();
-  for (std::size_t c = 0; c < count; ++c) {
-    for (std::size_t m = cluster_start_[c]; m < cluster_start_[c + 1]; ++m) {
-      const TrackedLine& s = segments[members_[m]];
-      const std::uint64_t owner = previous_owner(s.id);
-      if (owner != kNoId) votes_.push_back({c, owner, s.segment.length()});
-    }
-  }
-  std::sort(votes_.begin(), votes_.end(), [](const Vote& a, const Vote& b) {
-    return a.cluster != b.cluster ? a.cluster < b.cluster : a.id < b.id;
-  });
-  std::size_t merged = 0;
-  for (std::size_t v = 0; v < votes_.size(); ++v) {
-    if (merged > 0 && votes_[merged - 1].cluster == votes_[v].cluster && votes_[merged - 1].id == votes_[v].id) {
-      votes_[merged - 1].length += votes_[v].length;
-    } else {
-      votes_[merged++] = votes_[v];
-    }
-  }
-  votes_.resize(merged);
-  std::sort(votes_.begin(), votes_.end(), [](const Vote& a, const Vote& b) {
-    if (a.length != b.length) return a.length > b.length;
-    return a.id != b.id ? a.id < b.id : a.cluster < b.cluster;
-  });
-  id_of_cluster_.assign(count, kNoId);
-  first_seen_of_cluster_.assign(count, t);
-  line_of_id_.clear();
-  for (std::size_t i = 0; i < lines_.size(); ++i) line_of_id_.emplace_back(lines_[i].id, i);
-  std::sort(line_of_id_.begin(), line_of_id_.end());
-  for (const Vote& v : votes_) {
-    if (id_of_cluster_[v.cluster] != kNoId) continue;
-    const auto it = std::lower_bound(line_of_id_.begin(), line_of_id_.end(), std::pair(v.id, std::size_t{0}));
-    WholeLine& previous = lines_[it->second];  // every voted id is one of the last step's lines
-    if (previous.last_seen_us < 0) continue;  // taken by a line holding more of it
-    id_of_cluster_[v.cluster] = v.id;
-    first_seen_of_cluster_[v.cluster] = previous.first_seen_us;
-    previous.last_seen_us = -1;  // marks it taken
-  }
-  // Earlier lines nobody took have ended; they may be taken up again within keep_id_us.
-  for (const WholeLine& l : lines_) {
-    if (l.last_seen_us >= 0) ended_.push_back(l);
-  }
-  std::erase_if(ended_, [&](const WholeLine& l) { return l.id == kNoId || t - l.last_seen_us > params_.keep_id_us; });
-  for (std::size_t c = 0; c < count; ++c) {
-    if (id_of_cluster_[c] != kNoId) continue;
-    const std::size_t e = find_ended(clusters_[c], t);
-    if (e != kNone) {
-      id_of_cluster_[c] = ended_[e].id;
-      first_seen_of_cluster_[c] = ended_[e].first_seen_us;
-      ended_[e].id = kNoId;  // taken
-    } else {
-      id_of_cluster_[c] = next_id_++;
-    }
+  // New lines from the segments left.
+  for (const std::uint32_t seed : order_) {
+    if (cluster_of_segment_[seed] != kUnassigned || !(segments[seed].segment.length() > 0)) continue;
+    const Segment& s = segments[seed].segment;
+    Cluster cluster;
+    cluster.first_member = members_.size();
+    cluster.model.direction = (s.q1 - s.q0).normalized();
+    add_member(cluster, seed, segments);
+    grow(cluster, previous_owner(segments[seed].id), segments);
+    clusters_.push_back(cluster);
+    track_of_cluster_.push_back(kNone);
   }
 
-  lines_.clear();
+  const auto members_of = [&](std::size_t c) {
+    const std::size_t end = c + 1 < clusters_.size() ? clusters_[c + 1].first_member : members_.size();
+    return static_cast<std::uint32_t>(end - clusters_[c].first_member);
+  };
+  next_tracks_.clear();
   next_owner_.clear();
-  for (std::size_t c = 0; c < count; ++c) {
-    const Cluster& cluster = clusters_[c];
-    WholeLine line;
-    line.id = id_of_cluster_[c];
-    line.segment = {cluster.point + cluster.t_min * cluster.direction, cluster.point + cluster.t_max * cluster.direction};
-    line.segments = static_cast<std::uint32_t>(cluster_start_[c + 1] - cluster_start_[c]);
-    line.first_seen_us = first_seen_of_cluster_[c];
-    line.last_seen_us = t;
-    lines_.push_back(line);
-    for (std::size_t m = cluster_start_[c]; m < cluster_start_[c + 1]; ++m) {
-      next_owner_.emplace_back(segments[members_[m]].id, line.id);
+  const auto take_ownership = [&](std::size_t c, std::uint64_t key) {
+    const std::size_t first = clusters_[c].first_member;
+    for (std::size_t m = first; m < first + members_of(c); ++m) next_owner_.emplace_back(segments[members_[m]].id, key);
+  };
+  std::size_t c = 0;
+  for (std::size_t k = 0; k < tracks_.size(); ++k) {
+    Track& track = tracks_[k];
+    if (c < clusters_.size() && track_of_cluster_[c] == k) {
+      continue_track(track, clusters_[c], members_of(c), t);
+      take_ownership(c++, track.key);
+    } else if (t - track.last_seen_us > params_.keep_id_us) {
+      continue;  // ended
+    } else {
+      track.segments = 0;  // waiting
     }
+    next_tracks_.push_back(track);
   }
+  for (; c < clusters_.size(); ++c) {
+    const Track track{.key = next_key_++, .model = clusters_[c].model, .first_seen_us = t, .last_seen_us = t,
+                      .end_seen_us = {t, t}, .segments = members_of(c)};
+    take_ownership(c, track.key);
+    next_tracks_.push_back(track);
+  }
+  tracks_.swap(next_tracks_);
   std::sort(next_owner_.begin(), next_owner_.end());
   owner_.swap(next_owner_);
+
+  published_.clear();
+  const float min_length = params_.min_length_ratio * block_size_;
+  for (Track& track : tracks_) {
+    if (track.segments == 0) continue;
+    if (track.id == 0 && track.model.t_max - track.model.t_min < min_length) continue;
+    const LineModel& m = track.model;
+    const Segment segment{m.point + m.t_min * m.direction, m.point + m.t_max * m.direction};
+    if (track.id == 0 && shadowed(segment)) continue;
+    if (track.id == 0) track.id = next_id_++;
+    published_.push_back({.id = track.id,
+                          .segment = segment,
+                          .segments = track.segments,
+                          .first_seen_us = track.first_seen_us,
+                          .last_seen_us = t});
+  }
+  // Published lines first, in the order they were published, then the rest by age: in a merge the
+  // line published first keeps its id.
+  std::sort(tracks_.begin(), tracks_.end(), [](const Track& a, const Track& b) {
+    return std::tuple(a.id == 0, a.id, a.key) < std::tuple(b.id == 0, b.id, b.key);
+  });
+  meet_at_corners();
 }
 
 void as_tracked_lines(std::span<const WholeLine> lines, std::vector<TrackedLine>& out) {

@@ -27,10 +27,10 @@ class PipelineOptions {
   std::optional<int> width_, height_, block_size_, fit_iterations_;
   std::optional<double> alpha_;
   std::optional<float> fit_threshold_, inlier_ratio_, perturbation_, reassociation_angle_, reassociation_offset_;
-  std::optional<float> whole_angle_, whole_offset_, whole_gap_;
+  std::optional<float> whole_angle_, whole_offset_, whole_gap_, whole_min_length_, whole_corner_reach_, whole_corner_angle_;
   std::optional<std::string> multi_block_norm_;
   std::optional<Timestamp> track_period_, detect_period_, bad_track_patience_, reassociation_window_,
-      whole_keep_id_;
+      whole_keep_id_, whole_end_memory_;
   std::optional<std::string> filters_;
   std::optional<Timestamp> ba_window_, filter_refractory_, hot_window_;
   std::optional<double> ba_min_noise_hz_, hot_rate_, hot_ratio_, flicker_min_hz_, flicker_max_hz_;

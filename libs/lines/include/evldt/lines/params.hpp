@@ -57,7 +57,15 @@ struct WholeLineParams {
   float max_angle_deg = 12.0f;     ///< a segment joins a line whose direction is this close to its own
   float max_offset_ratio = 0.6f;   ///< of b: both its ends within this of the line
   float max_gap_ratio = 2.0f;      ///< of b: and it overlaps the line's extent or is at most this far from it
-  Timestamp keep_id_us = 100'000;  ///< a line not seen for this long gives up its id
+  Timestamp keep_id_us = 1'000'000;  ///< a line without segments for this long ends; before, it may take segments up again
+  /// An end its segments no longer reach stays this long: a block segment at the end of an edge comes
+  /// and goes with the events there, the edge does not.
+  Timestamp end_memory_us = 100'000;
+  float min_length_ratio = 3.0f;  ///< of b: a line is published once it is this long (then while it lasts)
+  /// of b: two published lines whose ends both lie this close to where they cross meet there (a corner:
+  /// the block at a corner holds two edges and fits neither, so both fall short of it). 0: off.
+  float corner_reach_ratio = 2.0f;
+  float corner_min_angle_deg = 30.0f;  ///< lines closer in direction than this do not make a corner
 };
 
 struct PipelineConfig {

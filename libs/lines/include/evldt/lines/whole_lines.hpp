@@ -1,8 +1,9 @@
 #pragma once
-// Whole lines: block segments that lie along one straight edge, joined into a line with its own
-// id, which it keeps while its segments come and go (issues 15 and 16). Runs on a snapshot of the
-// live segments at each output step, after tracking; deterministic for a given sequence of calls.
+// Whole lines: block segments that lie along one straight edge, joined into a line that is tracked
+// as one object over time, with its own id (issues 15 and 16). Runs on a snapshot of the live
+// segments at each output step, after tracking; deterministic for a given sequence of calls.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -15,9 +16,9 @@ namespace evldt {
 
 struct WholeLine {
   std::uint64_t id = 0;
-  Segment segment;              ///< the fitted line over the extent of its segments
-  std::uint32_t segments = 0;   ///< block segments joined into it
-  Timestamp first_seen_us = 0;
+  Segment segment;              ///< the fitted line over the extent of its segments (and remembered ends)
+  std::uint32_t segments = 0;   ///< block segments joined into it at this step
+  Timestamp first_seen_us = 0;  ///< when its track began
   Timestamp last_seen_us = 0;
 };
 
@@ -27,37 +28,65 @@ class WholeLineTracker {
   /// service folds its start time in, as for segment ids).
   explicit WholeLineTracker(int block_size, const WholeLineParams& params = {}, std::uint64_t first_id = 1);
 
-  /// Joins the segments of one step into whole lines and carries ids over from the previous step:
-  /// a line takes the id of the earlier line that most of its segments' length belonged to (each id
-  /// once), else of a line that ended within keep_id_us along the same stretch of edge, else a new
-  /// id. Steps must come in time order.
+  /// One step: each line tracked so far, oldest first, takes back the segments it held that still lie
+  /// along it and grows along its edge over free segments (taking over a younger line's segments where
+  /// they fit, which merges the two); a line that finds none waits keep_id_us under its last geometry
+  /// and may take segments up again. The segments left start new lines. An end that its segments no
+  /// longer reach stays where it was for end_memory_us. Steps must come in time order.
   void update(Timestamp t, std::span<const TrackedLine> segments);
 
-  [[nodiscard]] const std::vector<WholeLine>& lines() const { return lines_; }
+  /// The lines of the last step that are published: those holding segments now that reached
+  /// min_length_ratio * b at some step. Ids are given on publication, so a line never published uses none.
+  [[nodiscard]] const std::vector<WholeLine>& lines() const { return published_; }
   /// Time of the last update (0 before the first).
   [[nodiscard]] Timestamp last_time() const { return last_t_; }
-  /// Distinct ids given so far.
+  /// Distinct ids published so far.
   [[nodiscard]] std::uint64_t created() const { return next_id_ - first_id_; }
 
  private:
-  /// A line being grown: the length-weighted fit through its members' ends.
-  struct Cluster {
-    Point2 point = Point2::Zero();  ///< centroid of the members' ends, on the fitted line
+  /// An infinite line through `point` along unit `direction`, and an extent [t_min, t_max] along it.
+  struct LineModel {
+    Point2 point = Point2::Zero();
     Point2 direction = Point2::UnitX();
-    float t_min = 0, t_max = 0;  ///< extent along direction from point
-    double weight = 0, sum_x = 0, sum_y = 0, sum_xx = 0, sum_xy = 0, sum_yy = 0;
+    float t_min = 0, t_max = 0;
   };
+  struct Track {
+    std::uint64_t key = 0;  ///< internal, for segment ownership; every track has one
+    std::uint64_t id = 0;   ///< public, 0 until published
+    LineModel model;
+    Timestamp first_seen_us = 0;
+    Timestamp last_seen_us = 0;              ///< last step with segments
+    std::array<Timestamp, 2> end_seen_us{};  ///< last step the segments reached the t_min / t_max end
+    std::uint32_t segments = 0;
+  };
+  /// A line being grown this step: the length-weighted fit through its members' ends.
+  struct Cluster {
+    LineModel model;
+    double weight = 0, sum_x = 0, sum_y = 0, sum_xx = 0, sum_xy = 0, sum_yy = 0;
+    std::size_t first_member = 0;
+  };
+
   [[nodiscard]] std::int64_t cell_of(const Point2& p) const;
-  /// together_before: the segment and the cluster's seed belonged to one line at the last step;
-  /// such a pair joins within twice the angle, offset and gap (hysteresis: a line does not split
-  /// for a step's wobble).
-  [[nodiscard]] bool fits(const Cluster& cluster, const Segment& segment, bool together_before) const;
-  /// The whole-line id a segment belonged to at the last step, or 0.
+  /// Whether `segment` lies along `line`: direction, both ends' offsets and the gap to its extent
+  /// within the bounds, times `relax` (2 for a segment that was part of this line at the last step:
+  /// hysteresis, a line does not split for a step's wobble).
+  [[nodiscard]] bool fits(const LineModel& line, const Segment& segment, float relax) const;
+  /// The track key a segment belonged to at the last step, or 0.
   [[nodiscard]] std::uint64_t previous_owner(std::uint64_t segment_id) const;
-  /// Adds a member's ends to the moments and refits direction and extent over members [first, end).
-  void add_member(Cluster& cluster, std::size_t first, std::span<const TrackedLine> segments) const;
-  /// The index of the earlier line, ended within keep_id_us, that `cluster` continues, or npos.
-  [[nodiscard]] std::size_t find_ended(const Cluster& cluster, Timestamp t) const;
+  /// Adds segment `s` as a member of the last cluster and refits its direction and extent.
+  void add_member(Cluster& cluster, std::uint32_t s, std::span<const TrackedLine> segments);
+  /// Adds to the last cluster every free segment that fits it, searching the grid cells around its
+  /// members' ends. owner: the key whose former segments fit loosely (0: none).
+  void grow(Cluster& cluster, std::uint64_t owner, std::span<const TrackedLine> segments);
+  /// The first free segment (in grid order) that fits `line`, searched along its extent, or npos.
+  [[nodiscard]] std::size_t first_fit_along(const LineModel& line, std::span<const TrackedLine> segments) const;
+  /// Whether a line published at this step lies along `segment` (loosely): a second line on its edge
+  /// waits until it merges into it or outlives it.
+  [[nodiscard]] bool shadowed(const Segment& segment) const;
+  /// Moves the ends of published lines that make a corner to the corner (WholeLineParams::corner_*).
+  void meet_at_corners();
+  /// `track` followed by cluster `c`: new geometry, remembered ends, times.
+  void continue_track(Track& track, const Cluster& cluster, std::uint32_t members, Timestamp t) const;
 
   float block_size_;
   WholeLineParams params_;
@@ -66,27 +95,29 @@ class WholeLineTracker {
   float loose_cos_angle_;
   std::uint64_t first_id_;
   std::uint64_t next_id_;
+  std::uint64_t next_key_ = 1;
   bool stepped_ = false;
   Timestamp last_t_ = 0;
-  std::vector<WholeLine> lines_;
-  std::vector<WholeLine> ended_;  ///< lines that ended within keep_id_us
+  std::vector<Track> tracks_;  ///< oldest first
+  std::vector<WholeLine> published_;
 
   // Scratch, kept between calls.
   std::vector<std::pair<std::int64_t, std::uint32_t>> grid_;  ///< (cell of a segment end, segment), sorted
   std::vector<std::uint32_t> order_, members_, cluster_of_segment_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> owned_;  ///< (former owner key, segment), by key then length
   std::vector<Cluster> clusters_;
-  std::vector<std::size_t> cluster_start_;  ///< members of cluster c: members_[start[c], start[c + 1])
-  std::vector<std::uint64_t> id_of_cluster_;
-  std::vector<Timestamp> first_seen_of_cluster_;
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> owner_;  ///< (segment id, whole id) of the last step, sorted
+  std::vector<std::size_t> track_of_cluster_;  ///< index into tracks_, or npos for a new line
+  std::vector<Track> next_tracks_;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> owner_;  ///< (segment id, track key) of the last step, sorted
   std::vector<std::pair<std::uint64_t, std::uint64_t>> next_owner_;
-  std::vector<std::pair<std::uint64_t, std::size_t>> line_of_id_;  ///< (id, index into lines_), sorted
-  struct Vote {
-    std::size_t cluster = 0;
-    std::uint64_t id = 0;
-    double length = 0;
+  std::vector<std::pair<std::int64_t, std::uint32_t>> end_grid_;  ///< (cell, published line * 2 + end), sorted
+  struct Corner {
+    float cost = 0;  ///< the two ends' distances to the corner
+    std::uint32_t end_a = 0, end_b = 0;
+    Point2 at = Point2::Zero();
   };
-  std::vector<Vote> votes_;
+  std::vector<Corner> corners_;
+  std::vector<std::uint8_t> end_moved_;
 };
 
 /// Whole lines as rows of the segment format (segment_csv.hpp): score = the number of block segments
