@@ -22,6 +22,7 @@
 #include "evldt/events/event_writer.hpp"
 #include "evldt/sources/event_source.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
+#include "evldt/lines/whole_lines.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
@@ -61,6 +62,8 @@ struct Figures {
   double lines_created = 0;
   Timing track;                 ///< per pass
   double lines_tracked = 0;
+  Timing whole;                 ///< per whole-line step, over the window's output steps from an empty state
+  double whole_lines = 0;       ///< published at the window's last step
   Timing snapshot;              ///< per full lattice copy (the real-time loops' consistent view)
   Timing snapshot_1ms;          ///< per update of a view after 1 ms of the scene's events
   Timing filters;               ///< per event, the default noise filters from an empty state
@@ -171,8 +174,12 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   structs = {};
   f.receive = per_item(time_receive(settings, scene.sensor, events), n);
 
-  // The passes run on the state at the end of the window.
+  // The passes run on the state at the end of the window; the whole-line steps on its output steps.
   DeterministicPipeline busy(config);
+  std::vector<std::pair<Timestamp, std::vector<TrackedLine>>> output_steps;
+  busy.set_output(10000, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
+    output_steps.emplace_back(t, std::vector<TrackedLine>(lines.lines().begin(), lines.lines().end()));
+  });
   busy.process(events);
   const ScarfLattice& state = busy.lattice();
   for (int block = 0; block < state.geometry().block_count(); ++block) f.active_points += state.active_count(block);
@@ -196,6 +203,15 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
     tracker.track(state, tracked, 0);
   });
   f.track = {track_and_copy.median - copy.median, track_and_copy.min - copy.median, track_and_copy.max - copy.median};
+
+  BenchSettings replays = settings;
+  replays.min_time_s = 0;  // a replay of every step is long enough
+  f.whole = per_item(time_op(replays, [&] {
+                       WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
+                       for (const auto& [t, lines] : output_steps) joiner.update(t, lines);
+                       f.whole_lines = static_cast<double>(joiner.lines().size());
+                     }),
+                     static_cast<double>(std::max<std::size_t>(output_steps.size(), 1)));
 
   // The snapshot of a real-time loop: in full (a new source), and after 1 ms of events (only the
   // blocks they changed).
@@ -282,20 +298,21 @@ std::optional<Figures> measure_in_child(const SizeCase& size_case, const BenchSe
 }
 
 void print_header() {
-  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %8s %8s %8s %10s %9s %9s %8s\n", "size", "scene", "Mev/s*", "storage",
-              "(AoS)", "receive", "detect", "ns/point", "track", "ns/line", "copy", "1ms-upd", "filters", "pipeline", "(no filt)",
-              "lattice", "RSS");
-  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %8s %8s %8s %10s %9s %9s %8s\n", "", "", "scene", "Mev/s", "Mev/s", "Mev/s",
-              "Hz", "(points)", "Hz", "(lines)", "us", "us", "Mev/s", "Mev/s", "Mev/s", "MB", "MB");
+  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %9s %8s %8s %8s %8s %10s %9s %9s %8s\n", "size", "scene", "Mev/s*",
+              "storage", "(AoS)", "receive", "detect", "ns/point", "track", "ns/line", "whole", "(lines)", "copy", "1ms-upd",
+              "filters", "pipeline", "(no filt)", "lattice", "RSS");
+  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %9s %8s %8s %8s %8s %10s %9s %9s %8s\n", "", "", "scene", "Mev/s",
+              "Mev/s", "Mev/s", "Hz", "(points)", "Hz", "(lines)", "Hz", "", "us", "us", "Mev/s", "Mev/s", "Mev/s", "MB", "MB");
 }
 
 void print_row(const SizeCase& c, const Figures& f) {
   char points[32], lines[32];
   std::snprintf(points, sizeof points, "%.1f (%.0f)", f.detect.median * 1e9 / std::max(f.active_points, 1.0), f.active_points);
   std::snprintf(lines, sizeof lines, "%.0f (%.0f)", f.track.median * 1e9 / std::max(f.lines_tracked, 1.0), f.lines_tracked);
-  std::printf("%-9s %-17s %7.2f %9.1f %9.1f %9.1f %10.0f %11s %10.0f %12s %8.1f %8.1f %8.1f %10.2f %9.2f %9.2f %8.0f\n", c.label,
-              c.scene, f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median, 1e-6 / f.receive.median,
-              1.0 / f.detect.median, points, 1.0 / f.track.median, lines, f.snapshot.median * 1e6, f.snapshot_1ms.median * 1e6,
+  std::printf("%-9s %-17s %7.2f %9.1f %9.1f %9.1f %10.0f %11s %10.0f %12s %9.0f %8.0f %8.1f %8.1f %8.1f %10.2f %9.2f %9.2f %8.0f\n",
+              c.label, c.scene, f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median,
+              1e-6 / f.receive.median, 1.0 / f.detect.median, points, 1.0 / f.track.median, lines, 1.0 / f.whole.median,
+              f.whole_lines, f.snapshot.median * 1e6, f.snapshot_1ms.median * 1e6,
               1e-6 / f.filters.median, 1e-6 / f.pipeline.median, 1e-6 / f.pipeline_unfiltered.median, f.lattice_mb, f.peak_rss_mb);
   std::fflush(stdout);
 }
@@ -320,6 +337,7 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
     write_timing(out, "receive_ns_per_event", f.receive, "ns", 1e9);
     write_timing(out, "detect_pass_us", f.detect, "us", 1e6);
     write_timing(out, "track_pass_us", f.track, "us", 1e6);
+    write_timing(out, "whole_line_step_us", f.whole, "us", 1e6);
     write_timing(out, "snapshot_us", f.snapshot, "us", 1e6);
     write_timing(out, "snapshot_after_1ms_us", f.snapshot_1ms, "us", 1e6);
     write_timing(out, "filters_ns_per_event", f.filters, "ns", 1e9);
@@ -333,6 +351,8 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
         << "      \"track_hz\": " << 1.0 / f.track.median << ",\n"
         << "      \"track_ns_per_line\": " << f.track.median * 1e9 / std::max(f.lines_tracked, 1.0) << ",\n"
         << "      \"lines_tracked\": " << f.lines_tracked << ",\n"
+        << "      \"whole_line_hz\": " << 1.0 / f.whole.median << ",\n"
+        << "      \"whole_lines\": " << f.whole_lines << ",\n"
         << "      \"filters_mev_s\": " << 1e-6 / f.filters.median << ",\n"
         << "      \"pipeline_mev_s\": " << 1e-6 / f.pipeline.median << ",\n"
         << "      \"pipeline_unfiltered_mev_s\": " << 1e-6 / f.pipeline_unfiltered.median << ",\n"

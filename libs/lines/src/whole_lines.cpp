@@ -32,12 +32,6 @@ WholeLineTracker::WholeLineTracker(int block_size, const WholeLineParams& params
   if (block_size <= 0) throw std::invalid_argument("whole lines need a positive block size, got " + std::to_string(block_size));
 }
 
-std::int64_t WholeLineTracker::cell_of(const Point2& p) const {
-  const auto cx = static_cast<std::int64_t>(std::floor(p.x() / cell_size_));
-  const auto cy = static_cast<std::int64_t>(std::floor(p.y() / cell_size_));
-  return (cy << 32) + cx;
-}
-
 bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float relax) const {
   const Point2 along = segment.q1 - segment.q0;
   const float length = along.norm();
@@ -102,20 +96,12 @@ void WholeLineTracker::grow(Cluster& cluster, std::uint64_t owner, std::span<con
   for (std::size_t next = cluster.first_member; next < members_.size(); ++next) {
     const Segment& s = segments[members_[next]].segment;
     for (const Point2& end : {s.q0, s.q1}) {
-      const std::int64_t centre = cell_of(end);
-      for (std::int64_t dy = -1; dy <= 1; ++dy) {
-        for (std::int64_t dx = -1; dx <= 1; ++dx) {
-          const std::int64_t cell = centre + (dy << 32) + dx;
-          auto it = std::lower_bound(grid_.begin(), grid_.end(), std::pair(cell, std::uint32_t{0}));
-          for (; it != grid_.end() && it->first == cell; ++it) {
-            const std::uint32_t k = it->second;
-            if (cluster_of_segment_[k] != kUnassigned) continue;
-            const bool was_member = owner != kNoKey && previous_owner(segments[k].id) == owner;
-            if (!fits(cluster.model, segments[k].segment, was_member ? kLooseJoin : 1.0f)) continue;
-            add_member(cluster, k, segments);
-          }
-        }
-      }
+      end_grid_.for_each_near(end, [&](std::uint32_t end_index) {
+        const std::uint32_t k = end_index / 2;
+        if (cluster_of_segment_[k] != kUnassigned) return;
+        const bool was_member = owner != kNoKey && owner_of_segment_[k] == owner;
+        if (fits(cluster.model, segments[k].segment, was_member ? kLooseJoin : 1.0f)) add_member(cluster, k, segments);
+      });
     }
   }
 }
@@ -123,22 +109,15 @@ void WholeLineTracker::grow(Cluster& cluster, std::uint64_t owner, std::span<con
 std::size_t WholeLineTracker::first_fit_along(const LineModel& line, std::span<const TrackedLine> segments) const {
   const float length = line.t_max - line.t_min;
   const int samples = 1 + static_cast<int>(std::ceil(length / cell_size_));
-  for (int i = 0; i <= samples; ++i) {
+  std::size_t found = kNone;
+  for (int i = 0; i <= samples && found == kNone; ++i) {
     const Point2 at = line.point + (line.t_min + length * static_cast<float>(i) / static_cast<float>(samples)) * line.direction;
-    const std::int64_t centre = cell_of(at);
-    for (std::int64_t dy = -1; dy <= 1; ++dy) {
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        const std::int64_t cell = centre + (dy << 32) + dx;
-        auto it = std::lower_bound(grid_.begin(), grid_.end(), std::pair(cell, std::uint32_t{0}));
-        for (; it != grid_.end() && it->first == cell; ++it) {
-          if (cluster_of_segment_[it->second] == kUnassigned && fits(line, segments[it->second].segment, kLooseJoin)) {
-            return it->second;
-          }
-        }
-      }
-    }
+    end_grid_.for_each_near(at, [&](std::uint32_t end_index) {
+      const std::uint32_t k = end_index / 2;
+      if (found == kNone && cluster_of_segment_[k] == kUnassigned && fits(line, segments[k].segment, kLooseJoin)) found = k;
+    });
   }
-  return kNone;
+  return found;
 }
 
 void WholeLineTracker::continue_track(Track& track, const Cluster& cluster, std::uint32_t members, Timestamp t) const {
@@ -188,41 +167,28 @@ void WholeLineTracker::meet_at_corners() {
   const float reach = params_.corner_reach_ratio * block_size_;
   if (!(reach > 0) || published_.size() < 2) return;
   const float min_sin = std::sin(params_.corner_min_angle_deg * std::numbers::pi_v<float> / 180.0f);
-  // Two ends within reach of one corner are within 2 reach of each other: cells that wide, 3 x 3 of them.
-  const float cell = 2.0f * reach;
-  const auto cell_at = [cell](const Point2& p) {
-    return (static_cast<std::int64_t>(std::floor(p.y() / cell)) << 32) + static_cast<std::int64_t>(std::floor(p.x() / cell));
-  };
   const auto end_point = [&](std::uint32_t end) -> Point2& {
     Segment& s = published_[end / 2].segment;
     return end % 2 == 0 ? s.q0 : s.q1;
   };
-  end_grid_.clear();
-  for (std::uint32_t end = 0; end < 2 * published_.size(); ++end) end_grid_.emplace_back(cell_at(end_point(end)), end);
-  std::sort(end_grid_.begin(), end_grid_.end());
+  ends_.clear();
+  for (std::uint32_t end = 0; end < 2 * published_.size(); ++end) ends_.push_back(end_point(end));
+  // Two ends within reach of one corner are within 2 reach of each other: cells that wide, 3 x 3 of them.
+  corner_grid_.build(2.0f * reach, ends_);
   corners_.clear();
   for (std::uint32_t a = 0; a < 2 * published_.size(); ++a) {
     const Segment& line_a = published_[a / 2].segment;
     const Point2 pa = end_point(a), da = (line_a.q1 - line_a.q0).normalized();
-    const std::int64_t centre = cell_at(pa);
-    for (std::int64_t dy = -1; dy <= 1; ++dy) {
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        const std::int64_t c = centre + (dy << 32) + dx;
-        auto it = std::lower_bound(end_grid_.begin(), end_grid_.end(), std::pair(c, std::uint32_t{0}));
-        for (; it != end_grid_.end() && it->first == c; ++it) {
-          const std::uint32_t b = it->second;
-          if (b / 2 <= a / 2) continue;  // each pair of lines once, never a line with itself
-          const Segment& line_b = published_[b / 2].segment;
-          const Point2 pb = end_point(b), db = (line_b.q1 - line_b.q0).normalized();
-          const float sine = cross2(da, db);
-          if (std::abs(sine) < min_sin) continue;
-          const Point2 at = pa + (cross2(pb - pa, db) / sine) * da;
-          const float cost = (at - pa).norm() + (at - pb).norm();
-          if ((at - pa).norm() > reach || (at - pb).norm() > reach) continue;
-          corners_.push_back({cost, a, b, at});
-        }
-      }
-    }
+    corner_grid_.for_each_near(pa, [&](std::uint32_t b) {
+      if (b / 2 <= a / 2) return;  // each pair of lines once, never a line with itself
+      const Segment& line_b = published_[b / 2].segment;
+      const Point2 pb = end_point(b), db = (line_b.q1 - line_b.q0).normalized();
+      const float sine = cross2(da, db);
+      if (std::abs(sine) < min_sin) return;
+      const Point2 at = pa + (cross2(pb - pa, db) / sine) * da;
+      if ((at - pa).norm() > reach || (at - pb).norm() > reach) return;
+      corners_.push_back({(at - pa).norm() + (at - pb).norm(), a, b, at});
+    });
   }
   // Nearest corners first; an end meets one corner.
   std::sort(corners_.begin(), corners_.end(), [](const Corner& x, const Corner& y) {
@@ -243,15 +209,17 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   last_t_ = t;
   const auto n = static_cast<std::uint32_t>(segments.size());
 
-  grid_.clear();
+  ends_.clear();
   owned_.clear();
+  owner_of_segment_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) {
-    grid_.emplace_back(cell_of(segments[i].segment.q0), i);
-    grid_.emplace_back(cell_of(segments[i].segment.q1), i);
+    ends_.push_back(segments[i].segment.q0);
+    ends_.push_back(segments[i].segment.q1);
     const std::uint64_t owner = previous_owner(segments[i].id);
+    owner_of_segment_[i] = owner;
     if (owner != kNoKey) owned_.emplace_back(owner, i);
   }
-  std::sort(grid_.begin(), grid_.end());
+  end_grid_.build(cell_size_, ends_);
   // Longest segments first, of a line's former segments and of new lines' seeds, so a line's direction
   // comes from its best evidence.
   const auto longer = [&](std::uint32_t a, std::uint32_t b) {
@@ -300,7 +268,7 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     cluster.first_member = members_.size();
     cluster.model.direction = (s.q1 - s.q0).normalized();
     add_member(cluster, seed, segments);
-    grow(cluster, previous_owner(segments[seed].id), segments);
+    grow(cluster, owner_of_segment_[seed], segments);
     clusters_.push_back(cluster);
     track_of_cluster_.push_back(kNone);
   }
@@ -321,8 +289,8 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     if (c < clusters_.size() && track_of_cluster_[c] == k) {
       continue_track(track, clusters_[c], members_of(c), t);
       take_ownership(c++, track.key);
-    } else if (t - track.last_seen_us > params_.keep_id_us) {
-      continue;  // ended
+    } else if (track.id == 0 || t - track.last_seen_us > params_.keep_id_us) {
+      continue;  // ended (a line never published has no id to keep)
     } else {
       track.segments = 0;  // waiting
     }

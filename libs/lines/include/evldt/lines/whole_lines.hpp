@@ -11,6 +11,7 @@
 #include "evldt/events/event.hpp"
 #include "evldt/lines/geometry.hpp"
 #include "evldt/lines/line_map.hpp"
+#include "evldt/lines/point_grid.hpp"
 
 namespace evldt {
 
@@ -30,8 +31,8 @@ class WholeLineTracker {
 
   /// One step: each line tracked so far, oldest first, takes back the segments it held that still lie
   /// along it and grows along its edge over free segments (taking over a younger line's segments where
-  /// they fit, which merges the two); a line that finds none waits keep_id_us under its last geometry
-  /// and may take segments up again. The segments left start new lines. An end that its segments no
+  /// they fit, which merges the two); a published line that finds none waits keep_id_us under its
+  /// last geometry and may take segments up again (one never published ends). The segments left start new lines. An end that its segments no
   /// longer reach stays where it was for end_memory_us. Steps must come in time order.
   void update(Timestamp t, std::span<const TrackedLine> segments);
 
@@ -66,7 +67,6 @@ class WholeLineTracker {
     std::size_t first_member = 0;
   };
 
-  [[nodiscard]] std::int64_t cell_of(const Point2& p) const;
   /// Whether `segment` lies along `line`: direction, both ends' offsets and the gap to its extent
   /// within the bounds, times `relax` (2 for a segment that was part of this line at the last step:
   /// hysteresis, a line does not split for a step's wobble).
@@ -102,15 +102,17 @@ class WholeLineTracker {
   std::vector<WholeLine> published_;
 
   // Scratch, kept between calls.
-  std::vector<std::pair<std::int64_t, std::uint32_t>> grid_;  ///< (cell of a segment end, segment), sorted
+  std::vector<Point2> ends_;  ///< segment i's ends at 2i, 2i + 1 (published lines' in meet_at_corners)
+  PointGrid end_grid_;       ///< of the segments' ends
+  PointGrid corner_grid_;    ///< of the published lines' ends
   std::vector<std::uint32_t> order_, members_, cluster_of_segment_;
+  std::vector<std::uint64_t> owner_of_segment_;  ///< previous_owner() of each segment of this step
   std::vector<std::pair<std::uint64_t, std::uint32_t>> owned_;  ///< (former owner key, segment), by key then length
   std::vector<Cluster> clusters_;
   std::vector<std::size_t> track_of_cluster_;  ///< index into tracks_, or npos for a new line
   std::vector<Track> next_tracks_;
   std::vector<std::pair<std::uint64_t, std::uint64_t>> owner_;  ///< (segment id, track key) of the last step, sorted
   std::vector<std::pair<std::uint64_t, std::uint64_t>> next_owner_;
-  std::vector<std::pair<std::int64_t, std::uint32_t>> end_grid_;  ///< (cell, published line * 2 + end), sorted
   struct Corner {
     float cost = 0;  ///< the two ends' distances to the corner
     std::uint32_t end_a = 0, end_b = 0;
