@@ -60,7 +60,7 @@ class PointGrid {
  private:
   static constexpr float kMaxCells = 4096;
 
-  /// The cell holding p, clamped to the grid (a non-finite point goes to the first cell).
+  /// The cell holding p, clamped to the grid (NaN goes to the first cell, infinity to its border).
   [[nodiscard]] std::pair<int, int> cell_xy(const Point2& p) const {
     const auto clamp = [](float v, int count) {
       return v >= 0 ? static_cast<int>(std::min(v, static_cast<float>(count - 1))) : 0;
