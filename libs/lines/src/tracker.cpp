@@ -74,10 +74,12 @@ LineTracker::LineTracker(const LatticeGeometry& geometry, const ScoreParams& sco
 
 void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp now) {
   auto& all = lines.lines();
+  const bool settled_ok = lattice.versions_of() == versions_of_;
+  versions_of_ = lattice.versions_of();
   std::size_t i = 0;
   while (i < all.size()) {
     ReleaseReason reason{};
-    if (track_line(lattice, all[i], now, reason)) {
+    if (track_line(lattice, all[i], now, settled_ok, reason)) {
       ++i;
     } else {
       lines.release(i, reason);  // the last line moves into slot i and is tracked next
@@ -86,7 +88,8 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
   lines.manage(kSuppressRatio);
 }
 
-bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, ReleaseReason& reason) {
+bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, bool settled_ok,
+                             ReleaseReason& reason) {
   const float b = static_cast<float>(geometry_.block_size);
   if (line.segment.length() < 0.5f * b) {
     reason = ReleaseReason::TooShort;
@@ -98,6 +101,13 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Tim
     reason = ReleaseReason::LeftSensor;
     return false;
   }
+  std::uint64_t newest = 0;
+  for (const int cell : cells_) newest = std::max(newest, lattice.version(cell));
+  if (settled_ok && line.settled_version != 0 && line.settled_version == newest) {
+    ++settled_passes_;
+    return judge(line, now, reason);
+  }
+  line.settled_version = 0;
   int active = 0;
   for (const int cell : cells_) active += lattice.active_count(cell);
   if (active < geometry_.min_points()) {
@@ -135,8 +145,15 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Tim
       best = h;
     }
   }
+  // The base hypothesis is the segment itself once its ends sit on lattice lines (every pass puts
+  // them there); a pass that keeps it has settled the line.
+  if (best == 0 && hypotheses[0].q0 == line.segment.q0 && hypotheses[0].q1 == line.segment.q1) line.settled_version = newest;
   line.segment = hypotheses[best];
   line.score = best_score.score();
+  return judge(line, now, reason);
+}
+
+bool LineTracker::judge(TrackedLine& line, Timestamp now, ReleaseReason& reason) const {
   if (line.score > score_params_.fit_threshold) {
     line.status = LineStatus::GoodTrack;
     line.last_good_us = now;

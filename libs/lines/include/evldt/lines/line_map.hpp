@@ -29,6 +29,10 @@ struct TrackedLine {
   int admin_block = -1;
   Timestamp first_seen_us = 0;
   Timestamp last_good_us = 0;  ///< last time its score was above threshold (detection counts)
+  /// Tracker state: the newest version of the line's blocks at its last pass, if that pass left the
+  /// segment where it was; 0 otherwise. While its blocks keep that version a pass would repeat
+  /// itself exactly, so the tracker reuses its score.
+  std::uint64_t settled_version = 0;
 };
 
 /// Why a line ended; the pipeline's statistics count each.

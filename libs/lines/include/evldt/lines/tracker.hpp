@@ -32,12 +32,18 @@ class LineTracker {
  public:
   LineTracker(const LatticeGeometry& geometry, const ScoreParams& score, const TrackParams& track);
 
-  /// One tracking round over every line, followed by the manager.
+  /// One tracking round over every line, followed by the manager. A line whose blocks have not
+  /// changed since a pass that left it in place is not scored again: the pass would repeat itself.
   void track(const ScarfLattice& lattice, LineMap& lines, Timestamp now);
+  /// Line passes that reused a settled line's score instead of scoring it again.
+  [[nodiscard]] std::uint64_t settled_passes() const { return settled_passes_; }
 
  private:
-  /// Tracks one line; false when it must be released (reason set).
-  bool track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, ReleaseReason& reason);
+  /// Tracks one line; false when it must be released (reason set). settled_ok: versions of this
+  /// lattice may be compared with those the lines were settled at.
+  bool track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, bool settled_ok, ReleaseReason& reason);
+  /// Status after a pass that left line.score: good, or bad and released once out of patience.
+  bool judge(TrackedLine& line, Timestamp now, ReleaseReason& reason) const;
 
   LatticeGeometry geometry_;
   ScoreParams score_params_;
@@ -45,6 +51,8 @@ class LineTracker {
   FittingScorer scorer_;
   std::vector<int> cells_;               // scratch: blocks under the current line
   PointSet points_;                      // scratch: the event set of the current line
+  std::uint64_t versions_of_ = 0;        // ScarfLattice::versions_of() at the last round
+  std::uint64_t settled_passes_ = 0;
 };
 
 }  // namespace evldt
