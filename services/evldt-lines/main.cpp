@@ -29,6 +29,10 @@ int main(int argc, char** argv) {
   app.add_flag("--whole-lines,!--no-whole-lines", options.whole_lines,
                "Also publish whole lines (collinear touching segments joined, own ids) on WHOLE_LINES_<CAMERA>")
       ->capture_default_str();
+  app.add_option("--whole-lines-hz", options.whole_lines_hz,
+                 "Whole-line lists per second: with every k-th segment list, k = publish-hz / this rounded, at least 1")
+      ->capture_default_str()
+      ->check(finite_number() & CLI::Range(0.1, 10000.0));
   app.add_option("--log-period-s", options.log_period_s, "A status line in the log this often (0: never)")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.0, 3600.0));

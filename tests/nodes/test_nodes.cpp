@@ -84,6 +84,7 @@ CameraNodeOptions fast_camera() {
 LinesNodeOptions quiet_lines() {
   LinesNodeOptions options;
   options.publish_hz = 500;
+  options.whole_lines_hz = 500;  // a whole-line list with every segment list
   options.log_period_s = 0;
   return options;
 }
@@ -91,7 +92,8 @@ LinesNodeOptions quiet_lines() {
 // Runs a lines node on its own thread for the lifetime of the object.
 class RunningLines {
  public:
-  RunningLines(lcm::LCM& lcm, std::int64_t epoch) : node(lcm, quiet_lines(), epoch), thread_([this] { node.run(stop_); }) {}
+  RunningLines(lcm::LCM& lcm, std::int64_t epoch, const LinesNodeOptions& options = quiet_lines())
+      : node(lcm, options, epoch), thread_([this] { node.run(stop_); }) {}
   ~RunningLines() { stop(); }
   void stop() {
     stop_ = true;
@@ -122,7 +124,9 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
   ListCollector whole_collector(lcm, "WHOLE_LINES_CAM0");
   constexpr std::int64_t kEpoch = 5'000'000;
   const int kBlock = default_config_for(SensorSize{240, 180}).lattice.block_size;
-  RunningLines lines(lcm, kEpoch);
+  LinesNodeOptions options = quiet_lines();
+  options.whole_lines_hz = 100;  // with every 5th segment list
+  RunningLines lines(lcm, kEpoch, options);
   CameraNode camera(lcm, fast_camera(), 77);
   const std::atomic<bool> never{false};
   const CameraSummary sent = camera.run(scene_source("boxes-6dof", 400'000), never);
@@ -175,20 +179,24 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
   }
   EXPECT_GE(most_segments, 10u);  // boxes-6dof shows some 20 edges
 
-  // Whole lines: one list per segment list, published with it; each joins segments of that list
-  // (its score counts them; lines too short to publish hold the rest), and a line keeps its id
-  // while it lasts.
+  // Whole lines: a list with every 5th segment list (lists at 500 Hz, whole lines at 100 Hz), with
+  // its time and batch fields; each joins segments of that list (its score counts them; lines too
+  // short to publish hold the rest), and a line keeps its id while it lasts.
   // (LCM may hand over the last one of either kind after the snapshots above.)
+  constexpr std::size_t kListsPerWholeList = 5;
   const auto whole = whole_collector.lists();
-  ASSERT_LE(std::max(whole.size(), lists.size()) - std::min(whole.size(), lists.size()), 1u);
+  const std::size_t expected = (lists.size() + kListsPerWholeList - 1) / kListsPerWholeList;
+  ASSERT_LE(std::max(whole.size(), expected) - std::min(whole.size(), expected), 1u);
   EXPECT_EQ(whole_collector.invalid(), 0);
   std::size_t fewer = 0, continued = 0;
   double joined_segments = 0, all_segments = 0;
   std::set<std::uint64_t> previous_ids;
-  const std::size_t both = std::min(whole.size(), lists.size());
-  for (std::size_t k = 0; k < both; ++k) {
+  const std::size_t both = std::min(whole.size(), expected);
+  for (std::size_t k = 0; k < both && k * kListsPerWholeList < lists.size(); ++k) {
+    const segment_list_t& list = lists[k * kListsPerWholeList];
     EXPECT_EQ(whole[k].seq, static_cast<std::int64_t>(k));
-    EXPECT_EQ(whole[k].t_us, lists[k].t_us);
+    EXPECT_EQ(whole[k].t_us, list.t_us);
+    EXPECT_EQ(whole[k].newest_batch_seq, list.newest_batch_seq);
     std::vector<TrackedLine> joined;
     ASSERT_TRUE(read_segment_list(whole[k], joined));
     double segments = 0;
@@ -199,10 +207,10 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
       ids.insert(line.id);
       continued += previous_ids.count(line.id);
     }
-    EXPECT_LE(segments, static_cast<double>(lists[k].segments.size()));
+    EXPECT_LE(segments, static_cast<double>(list.segments.size()));
     joined_segments += segments;
-    all_segments += static_cast<double>(lists[k].segments.size());
-    fewer += joined.size() < lists[k].segments.size() ? 1 : 0;
+    all_segments += static_cast<double>(list.segments.size());
+    fewer += joined.size() < list.segments.size() ? 1 : 0;
     previous_ids = ids;
   }
   EXPECT_GT(fewer, both / 2);  // segments along one edge are joined

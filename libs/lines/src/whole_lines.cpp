@@ -237,7 +237,7 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   clusters_.clear();
   track_of_cluster_.clear();
   members_.clear();
-  // Lines tracked so far, oldest first: the older line wins a contested segment and keeps its id.
+  // Lines tracked so far, the first published first: it wins a contested segment and keeps its id.
   for (std::size_t k = 0; k < tracks_.size(); ++k) {
     const Track& track = tracks_[k];
     if (t - track.last_seen_us > params_.keep_id_us) continue;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
 
@@ -33,9 +34,11 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
       next_line_id_(static_cast<std::uint64_t>(epoch_us)),
       next_whole_id_(static_cast<std::uint64_t>(epoch_us)) {
   batch_.reserve(1 << 16);
-  if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100)) {
-    throw std::invalid_argument("publish rate must be in (0, 10000] Hz and stats rate in (0, 100] Hz");
+  if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100) ||
+      !(options_.whole_lines_hz > 0 && options_.whole_lines_hz <= 10000)) {
+    throw std::invalid_argument("publish and whole-line rates must be in (0, 10000] Hz and the stats rate in (0, 100] Hz");
   }
+  lists_per_whole_list_ = std::max<std::int64_t>(1, std::llround(options_.publish_hz / options_.whole_lines_hz));
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
   subscription_ = lcm_.subscribe(events_channel(options_.camera), &LinesNode::on_events, this);
   if (!subscription_) throw std::runtime_error("cannot subscribe to " + events_channel(options_.camera));
@@ -157,7 +160,7 @@ void LinesNode::publish_segments() {
   list_msg_.newest_batch_seq = included.seq;
   list_msg_.newest_batch_utime = included.utime;
   if (lcm_.publish(lines_channel_, &list_msg_) == 0) lists_published_.fetch_add(1, std::memory_order_relaxed);
-  if (options_.whole_lines) publish_whole_lines(engine, lattice_us);
+  if (options_.whole_lines && list_msg_.seq % lists_per_whole_list_ == 0) publish_whole_lines(engine, lattice_us);
 }
 
 void LinesNode::publish_whole_lines(const std::shared_ptr<RealtimeEngine>& engine, Timestamp lattice_us) {

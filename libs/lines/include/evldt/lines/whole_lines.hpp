@@ -29,7 +29,7 @@ class WholeLineTracker {
   /// service folds its start time in, as for segment ids).
   explicit WholeLineTracker(int block_size, const WholeLineParams& params = {}, std::uint64_t first_id = 1);
 
-  /// One step: each line tracked so far, oldest first, takes back the segments it held that still lie
+  /// One step: each line tracked so far, the first published first, takes back the segments it held that still lie
   /// along it and grows along its edge over free segments (taking over a younger line's segments where
   /// they fit, which merges the two); a published line that finds none waits keep_id_us under its
   /// last geometry and may take segments up again (one never published ends). The segments left start new lines. An end that its segments no
@@ -78,7 +78,8 @@ class WholeLineTracker {
   /// Adds to the last cluster every free segment that fits it, searching the grid cells around its
   /// members' ends. owner: the key whose former segments fit loosely (0: none).
   void grow(Cluster& cluster, std::uint64_t owner, std::span<const TrackedLine> segments);
-  /// The first free segment (in grid order) that fits `line`, searched along its extent, or npos.
+  /// The first free segment (in grid order) that fits `line` within twice the bounds (it may have
+  /// moved while the line waited), searched along its extent, or npos.
   [[nodiscard]] std::size_t first_fit_along(const LineModel& line, std::span<const TrackedLine> segments) const;
   /// Whether a line published at this step lies along `segment` (loosely): a second line on its edge
   /// waits until it merges into it or outlives it.
@@ -98,7 +99,7 @@ class WholeLineTracker {
   std::uint64_t next_key_ = 1;
   bool stepped_ = false;
   Timestamp last_t_ = 0;
-  std::vector<Track> tracks_;  ///< oldest first
+  std::vector<Track> tracks_;  ///< published ones first, in the order they were published; then by age
   std::vector<WholeLine> published_;
 
   // Scratch, kept between calls.
