@@ -7,6 +7,7 @@
 # behind shows as latency before it shows as loss).
 # Usage: tools/lcm-throughput-bench.sh [--scene NAME] [--seconds S] [--publish-hz HZ] [--speeds "1 2 4"]
 #                                      [--max-p99-ms MS] [--json FILE] [--build DIR]
+#                                      [--lines-arg ARG]...  (passed to evldt-lines, e.g. --no-whole-lines)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build/release
@@ -16,6 +17,7 @@ publish_hz=1000
 speeds="0.05 0.1 0.25 0.5 1 1.25"
 max_p99_ms=5
 json=
+lines_args=()
 while (($#)); do
   case $1 in
     --scene) scene=$2; shift 2 ;;
@@ -25,7 +27,8 @@ while (($#)); do
     --max-p99-ms) max_p99_ms=$2; shift 2 ;;
     --json) json=$2; shift 2 ;;
     --build) build=$2; shift 2 ;;
-    -h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --lines-arg) lines_args+=("$2"); shift 2 ;;
+    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "lcm-throughput-bench.sh: unknown argument $1 (see --help)" >&2; exit 1 ;;
   esac
 done
@@ -61,7 +64,7 @@ printf '%-7s %10s %14s %11s %11s %10s %14s\n' speed "Mev/s" "batches lost" "came
 rows=()
 best=0
 for speed in $speeds; do
-  "$lines" --lcm-url "$url" --publish-hz "$publish_hz" --log-period-s 0 >"$work/lines.out" 2>"$work/lines.err" &
+  "$lines" --lcm-url "$url" --publish-hz "$publish_hz" --log-period-s 0 ${lines_args[@]+"${lines_args[@]}"} >"$work/lines.out" 2>"$work/lines.err" &
   lines_pid=$!
   pids+=("$lines_pid")
   for _ in $(seq 1200); do grep -q "evldt-lines ready:" "$work/lines.err" && break; sleep 0.05; done
