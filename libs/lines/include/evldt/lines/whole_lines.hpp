@@ -29,11 +29,12 @@ class WholeLineTracker {
   /// service folds its start time in, as for segment ids).
   explicit WholeLineTracker(int block_size, const WholeLineParams& params = {}, std::uint64_t first_id = 1);
 
-  /// One step: each line tracked so far, the first published first, takes back the segments it held that still lie
-  /// along it and grows along its edge over free segments (taking over a younger line's segments where
-  /// they fit, which merges the two); a published line that finds none waits keep_id_us under its
-  /// last geometry and may take segments up again (one never published ends). The segments left start new lines. An end that its segments no
-  /// longer reach stays where it was for end_memory_us. Steps must come in time order.
+  /// One step. Each line tracked so far, the first published first, takes back the segments it held
+  /// that still lie along it and grows along its edge over free segments (taking over a younger
+  /// line's segments where they fit, which merges the two). A published line that finds none waits
+  /// keep_id_us under its last geometry and may take segments up again; one never published ends.
+  /// The segments left start new lines. An end its segments no longer reach stays where it was for
+  /// end_memory_us. Steps must come in time order.
   void update(Timestamp t, std::span<const TrackedLine> segments);
 
   /// The lines of the last step that are published: those holding segments now that reached
@@ -81,8 +82,8 @@ class WholeLineTracker {
   /// The first free segment (in grid order) that fits `line` within twice the bounds (it may have
   /// moved while the line waited), searched along its extent, or npos.
   [[nodiscard]] std::size_t first_fit_along(const LineModel& line, std::span<const TrackedLine> segments) const;
-  /// Whether a line published at this step lies along `segment` (loosely): a second line on its edge
-  /// waits until it merges into it or outlives it.
+  /// Whether a line published at this step lies along `segment` (within twice the bounds) and covers
+  /// half of it or more: a second line on its edge waits until it merges into it or outlives it.
   [[nodiscard]] bool shadowed(const Segment& segment) const;
   /// Moves the ends of published lines that make a corner to the corner (WholeLineParams::corner_*).
   void meet_at_corners();
