@@ -58,7 +58,7 @@ class PointGrid {
   }
 
  private:
-  static constexpr float kMaxCells = 4096;
+  static constexpr float kMaxCells = 1024;  // per side: a grid of 4 MB at most, whatever the points
 
   /// The cell holding p, clamped to the grid (NaN goes to the first cell, infinity to its border).
   [[nodiscard]] std::pair<int, int> cell_xy(const Point2& p) const {
