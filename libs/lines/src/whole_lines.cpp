@@ -184,7 +184,7 @@ void WholeLineTracker::meet_at_corners() {
       const Segment& line_b = published_[b / 2].segment;
       const Point2 pb = end_point(b), db = (line_b.q1 - line_b.q0).normalized();
       const float sine = cross2(da, db);
-      if (std::abs(sine) < min_sin) return;
+      if (!(std::abs(sine) >= std::max(min_sin, 1e-6f))) return;  // also a zero-length line's NaN, and parallel lines
       const Point2 at = pa + (cross2(pb - pa, db) / sine) * da;
       if ((at - pa).norm() > reach || (at - pb).norm() > reach) return;
       corners_.push_back({(at - pa).norm() + (at - pb).norm(), a, b, at});
