@@ -12,9 +12,9 @@ constexpr Timestamp kNever = std::numeric_limits<Timestamp>::min() / 2;
 BackgroundActivityFilter::BackgroundActivityFilter(SensorSize sensor, Timestamp window_us, double min_noise_hz)
     : EventFilter(sensor),
       window_us_(static_cast<std::uint32_t>(window_us)),
-      min_uncorrelated_(min_noise_hz * static_cast<double>(kJudgeUs) * 1e-6 * static_cast<double>(pixels())),
       stride_(sensor.width + 2),
-      last_event_(static_cast<std::size_t>(sensor.width + 2) * static_cast<std::size_t>(sensor.height + 2), 0) {
+      last_event_(static_cast<std::size_t>(sensor.width + 2) * static_cast<std::size_t>(sensor.height + 2), 0),
+      min_uncorrelated_(min_noise_hz * static_cast<double>(kJudgeUs) * 1e-6 * static_cast<double>(pixels())) {
   if (window_us <= 0 || window_us > 1'000'000'000) throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
   if (!(min_noise_hz >= 0)) throw std::invalid_argument("the background-activity noise level must not be negative");
 }
