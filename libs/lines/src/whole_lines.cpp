@@ -123,11 +123,10 @@ std::size_t WholeLineTracker::first_fit_along(const LineModel& line, std::span<c
 void WholeLineTracker::continue_track(Track& track, const Cluster& cluster, std::uint32_t members, Timestamp t) const {
   LineModel next = cluster.model;
   // Where the ends were, on the new line: an end the segments fall short of stays for end_memory_us.
-  const LineModel& before = track.model;
-  const float was_min = (before.point + before.t_min * before.direction - next.point).dot(next.direction);
-  const float was_max = (before.point + before.t_max * before.direction - next.point).dot(next.direction);
+  const Segment was = track.model.extent();
+  const float was_min = (was.q0 - next.point).dot(next.direction);
+  const float was_max = (was.q1 - next.point).dot(next.direction);
   // Only while the line itself is where it was: a line that turned or moved has no ends to keep.
-  const Segment was{before.point + before.t_min * before.direction, before.point + before.t_max * before.direction};
   const bool same_line = fits({next.point, next.direction, was_min, was_max}, was, 1.0f);
   const float reach = 0.5f * block_size_;
   const bool remember_min =
@@ -311,8 +310,7 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   for (Track& track : tracks_) {
     if (track.segments == 0) continue;
     if (track.id == 0 && track.model.t_max - track.model.t_min < min_length) continue;
-    const LineModel& m = track.model;
-    const Segment segment{m.point + m.t_min * m.direction, m.point + m.t_max * m.direction};
+    const Segment segment = track.model.extent();
     if (track.id == 0 && shadowed(segment)) continue;
     if (track.id == 0) track.id = next_id_++;
     published_.push_back({.id = track.id,

@@ -51,6 +51,7 @@ class WholeLineTracker {
     Point2 point = Point2::Zero();
     Point2 direction = Point2::UnitX();
     float t_min = 0, t_max = 0;
+    [[nodiscard]] Segment extent() const { return {point + t_min * direction, point + t_max * direction}; }
   };
   struct Track {
     std::uint64_t key = 0;  ///< internal, for segment ownership; every track has one
