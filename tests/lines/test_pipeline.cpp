@@ -6,6 +6,8 @@
 
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/lines/realtime_engine.hpp"
+#include "evldt/sim/event_simulator.hpp"
+#include "evldt/sim/scenes.hpp"
 #include "support/sweeping_edge.hpp"
 
 namespace evldt {
@@ -89,6 +91,58 @@ TEST(Pipeline, TwoRunsAreIdentical) {
     EXPECT_EQ(a[i].line.segment.q0, b[i].line.segment.q0);
     EXPECT_EQ(a[i].line.segment.q1, b[i].line.segment.q1);
     EXPECT_EQ(a[i].line.score, b[i].line.score);
+  }
+}
+
+TEST(Pipeline, OneTwoAndFourThreadsGiveTheSameOutput) {
+  // The busy HD scene: enough lines and blocks that every round is split over the pool.
+  Scene scene = make_scene("monitor-hd");
+  scene.duration_us = 60'000;
+  EventSimulator simulator(scene, SimulatorConfig{});
+  EventBatch events;
+  simulator.run_until(scene.duration_us, events);
+  PipelineConfig config = default_config_for(scene.sensor);
+  std::map<int, std::vector<Observation>> by_threads;
+  std::map<int, PipelineCounters> counters;
+  std::map<int, std::vector<std::uint64_t>> released;
+  for (const int threads : {1, 2, 4}) {
+    config.threads = threads;
+    DeterministicPipeline pipeline(config);
+    auto& seen = by_threads[threads];
+    std::size_t most_lines = 0;
+    pipeline.set_output(2000, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
+      most_lines = std::max(most_lines, lines.lines().size());
+      for (const TrackedLine& line : lines.lines()) seen.push_back({t, line});
+    });
+    pipeline.process(events);
+    ASSERT_GE(most_lines, 4 * LineTracker::kMinLinesToSplit);
+    ASSERT_GE(pipeline.lattice().geometry().block_count(), LineDetector::kMinBlocksToSplit);
+    counters[threads] = pipeline.counters();
+    for (int reason = 0; reason < kReleaseReasonCount; ++reason) {
+      released[threads].push_back(pipeline.lines().released(static_cast<ReleaseReason>(reason)));
+    }
+    released[threads].push_back(pipeline.lines().created());
+    released[threads].push_back(pipeline.lines().reassociated());
+  }
+  const auto& one = by_threads[1];
+  ASSERT_GT(one.size(), 10'000u);
+  for (const int threads : {2, 4}) {
+    const auto& other = by_threads[threads];
+    ASSERT_EQ(one.size(), other.size()) << threads << " threads";
+    for (std::size_t i = 0; i < one.size(); ++i) {
+      ASSERT_EQ(one[i].t, other[i].t);
+      ASSERT_EQ(one[i].line.id, other[i].line.id) << threads << " threads, at " << one[i].t;
+      ASSERT_EQ(one[i].line.segment.q0, other[i].line.segment.q0);
+      ASSERT_EQ(one[i].line.segment.q1, other[i].line.segment.q1);
+      ASSERT_EQ(one[i].line.score, other[i].line.score);
+      ASSERT_EQ(one[i].line.status, other[i].line.status);
+      ASSERT_EQ(one[i].line.admin_block, other[i].line.admin_block);
+      ASSERT_EQ(one[i].line.first_seen_us, other[i].line.first_seen_us);
+      ASSERT_EQ(one[i].line.last_good_us, other[i].line.last_good_us);
+    }
+    EXPECT_EQ(released[1], released[threads]) << threads << " threads: releases by reason, created, reassociated";
+    EXPECT_EQ(counters[1].track_rounds, counters[threads].track_rounds);
+    EXPECT_EQ(counters[1].detect_rounds, counters[threads].detect_rounds);
   }
 }
 

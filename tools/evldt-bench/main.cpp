@@ -1,5 +1,5 @@
 // evldt-bench: speed and memory of the core, and of receiving events off the wire, at every supported
-// sensor size, on one core. For each size a built-in scene is simulated (the first --window-ms), and
+// sensor size, on one core (--threads: detection and tracking passes and the pipeline on a pool). For each size a built-in scene is simulated (the first --window-ms), and
 // each figure is the median of --repeats timed repeats, each repeat long enough (--min-time-ms) for
 // the clock not to matter.
 // Every size runs in a child process of its own, so its peak RSS is its own.
@@ -76,6 +76,7 @@ struct Figures {
 
 struct BenchSettings {
   int repeats = 5;
+  int threads = 1;  ///< of the detection and tracking passes and the pipeline's rounds
   double min_time_s = 0.1;
   Timestamp window_us = 300000;
 };
@@ -155,7 +156,9 @@ Timing time_receive(const BenchSettings& settings, SensorSize sensor, const Even
 Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   const Scene scene = make_scene(size_case.scene);
   const EventBatch events = simulate(scene, settings.window_us);
-  const PipelineConfig config = default_config_for(scene.sensor);
+  PipelineConfig config = default_config_for(scene.sensor);
+  config.threads = settings.threads;
+  WorkerPool pool(settings.threads);
   const auto n = static_cast<double>(events.size());
   Figures f;
   f.events = n;
@@ -188,12 +191,12 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   f.detect = time_op(settings, [&] {
     // A fresh detector with every block free: the most work a pass can have (a detector skips the
     // blocks that failed before and have not changed since).
-    LineDetector detector(state.geometry(), config.score);
+    LineDetector detector(state.geometry(), config.score, &pool);
     detected.clear();
     f.lines_created = detector.detect(state, detected, 0);
   });
 
-  LineTracker tracker(state.geometry(), config.score, config.track);
+  LineTracker tracker(state.geometry(), config.score, config.track, &pool);
   LineMap start = busy.lines();
   // Every line scored: the most work a pass can have (a pass reuses the score of a line settled on
   // blocks that have not changed since).
@@ -329,7 +332,7 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
                 const std::vector<std::pair<SizeCase, Figures>>& results) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path.string());
-  out << "{\n  \"repeats\": " << settings.repeats << ",\n  \"min_time_s\": " << settings.min_time_s
+  out << "{\n  \"repeats\": " << settings.repeats << ",\n  \"threads\": " << settings.threads << ",\n  \"min_time_s\": " << settings.min_time_s
       << ",\n  \"window_us\": " << settings.window_us << ",\n  \"sizes\": [\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const auto& [c, f] = results[i];
@@ -428,6 +431,11 @@ int main(int argc, char** argv) {
   app.add_option("--window-ms", window_ms, "Scene time simulated per size; passes run on the state at its end")
       ->capture_default_str()
       ->check(CLI::Range(10.0, 10000.0) & finite_number());
+  app.add_option("--threads", settings.threads,
+                 "Threads of the detection and tracking passes and of the pipeline's rounds (storage, receiving and\n"
+                 "filters stay on one)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
   app.add_option("--json", json_path, "Write the figures as JSON");
   std::vector<std::filesystem::path> decode_files;
   app.add_option("--decode", decode_files,
@@ -446,8 +454,9 @@ int main(int argc, char** argv) {
     }
     settings.window_us = static_cast<Timestamp>(window_ms * 1e3);
     settings.min_time_s = min_time_ms * 1e-3;
-    std::printf("evldt-bench: one core, medians of %d repeats; *scene = event rate of the simulated scene\n",
-                settings.repeats);
+    std::printf("evldt-bench: %d thread(s) for the passes and rounds, medians of %d repeats; *scene = event rate of the\n"
+                "simulated scene\n",
+                settings.threads, settings.repeats);
     print_header();
     std::vector<std::pair<SizeCase, Figures>> results;
     bool failed = false;

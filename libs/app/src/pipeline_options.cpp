@@ -5,6 +5,8 @@
 #include <spdlog/spdlog.h>
 #include <stdexcept>
 
+#include "evldt/lines/worker_pool.hpp"
+
 namespace evldt {
 
 const CLI::Validator& finite_number() {
@@ -74,6 +76,10 @@ void PipelineOptions::add_to(CLI::App& app) {
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
   group->add_option("--detect-period-us", detect_period_, "Deterministic mode: detection period in event time")
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
+  group->add_option("--threads", threads_,
+                    "Threads each tracking and detection round is split over; the output is the same for any count\n"
+                    "(default: the machine's cores less one for the receiving thread, at least 1)")
+      ->check(CLI::Range(1, 64));
   auto* filters = app.add_option_group("Noise filters", "Run before storage, in the order given");
   filters->add_option("--filters", filters_,
                       "Filters in order, comma-separated: hot-pixel, background-activity, refractory, anti-flicker; or none\n"
@@ -131,6 +137,7 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   }
   if (track_period_) config.schedule.track_period_us = *track_period_;
   if (detect_period_) config.schedule.detect_period_us = *detect_period_;
+  config.threads = threads_.value_or(default_worker_threads());
   if (filters_) config.filters.chain = parse_filter_chain(*filters_);
   if (ba_window_) config.filters.background_window_us = *ba_window_;
   if (ba_min_noise_hz_) config.filters.background_min_noise_hz = *ba_min_noise_hz_;

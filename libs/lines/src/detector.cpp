@@ -1,5 +1,6 @@
 #include "evldt/lines/detector.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "evldt/lines/line_fit.hpp"
@@ -10,24 +11,55 @@ namespace {
 constexpr std::uint64_t kNeverFailed = UINT64_MAX;
 }  // namespace
 
-LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& params)
-    : geometry_(geometry),
-      params_(params),
-      scorer_(params.inlier_distance_ratio * static_cast<float>(geometry.block_size),
-              static_cast<float>(geometry.block_size) * 1.5f) {
-  points_.reserve(static_cast<std::size_t>(geometry.capacity));
+LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& params, WorkerPool* pool)
+    : geometry_(geometry), params_(params), pool_(pool) {
+  const int threads = pool ? pool->threads() : 1;
+  const float b = static_cast<float>(geometry.block_size);
+  workers_.reserve(static_cast<std::size_t>(threads));
+  for (int w = 0; w < threads; ++w) {
+    Worker& worker = workers_.emplace_back(Worker{FittingScorer(params.inlier_distance_ratio * b, b * 1.5f), {}});
+    worker.points.reserve(static_cast<std::size_t>(geometry.capacity));
+  }
   failed_at_.assign(static_cast<std::size_t>(geometry.block_count()), kNeverFailed);
+  found_.resize(static_cast<std::size_t>(geometry.block_count()));
 }
 
 int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now) {
-  const float b = static_cast<float>(geometry_.block_size);
-  const float capacity = static_cast<float>(geometry_.capacity);
-  int created = 0;
   if (lattice.versions_of() != versions_of_) {  // another lattice: its versions mean nothing here
     versions_of_ = lattice.versions_of();
     std::fill(failed_at_.begin(), failed_at_.end(), kNeverFailed);
   }
+  next_row_.store(0, std::memory_order_relaxed);
+  auto detect_claimed = [&](int w) {
+    Worker& worker = workers_[static_cast<std::size_t>(w)];
+    for (int row = next_row_.fetch_add(1, std::memory_order_relaxed); row < geometry_.blocks_y;
+         row = next_row_.fetch_add(1, std::memory_order_relaxed)) {
+      detect_row(lattice, lines, row, worker);
+    }
+  };
+  if (pool_ != nullptr && geometry_.block_count() >= kMinBlocksToSplit) {
+    pool_->run(detect_claimed);
+  } else {
+    detect_claimed(0);
+  }
+  // Lines are created in block order: a new line may take over the id of a line released nearby,
+  // and of two candidates the first block's wins, whatever worker found it.
+  int created = 0;
   for (int block = 0; block < geometry_.block_count(); ++block) {
+    Found& found = found_[static_cast<std::size_t>(block)];
+    if (!found.present) continue;
+    found.present = false;
+    lines.add(found.segment, found.score, block, now);
+    ++created;
+  }
+  return created;
+}
+
+void LineDetector::detect_row(const ScarfLattice& lattice, LineMap& lines, int row, Worker& worker) {
+  const float b = static_cast<float>(geometry_.block_size);
+  const float capacity = static_cast<float>(geometry_.capacity);
+  for (int column = 0; column < geometry_.blocks_x; ++column) {
+    const int block = geometry_.index(column, row);
     const BlockStatus status = lines.block_status(block);
     if (status == BlockStatus::ProhibitDetection) {
       lines.set_block_status(block, BlockStatus::NoDetect);  // suppression lasts one round
@@ -37,21 +69,18 @@ int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp 
     const std::uint64_t version = lattice.version(block);
     if (failed_at_[block] == version) continue;
     failed_at_[block] = version;  // until it succeeds below
-    points_.clear();
-    points_.add(lattice.entries(block), /*include_inactive=*/false);
-    const auto line = fit_line(points_, params_.fit_iterations);
+    worker.points.clear();
+    worker.points.add(lattice.entries(block), /*include_inactive=*/false);
+    const auto line = fit_line(worker.points, params_.fit_iterations);
     if (!line) continue;
-    const int i = geometry_.column(block), j = geometry_.row(block);
-    const auto segment = clip_to_square(*line, geometry_.origin_x(i), geometry_.origin_y(j), b);
+    const auto segment = clip_to_square(*line, geometry_.origin_x(column), geometry_.origin_y(row), b);
     if (!segment) continue;
-    const float f = scorer_.score(*segment, points_, capacity).score();
+    const float f = worker.scorer.score(*segment, worker.points, capacity).score();
     if (f > params_.fit_threshold) {
-      lines.add(*segment, f, block, now);
+      found_[static_cast<std::size_t>(block)] = {true, f, *segment};
       failed_at_[block] = kNeverFailed;
-      ++created;
     }
   }
-  return created;
 }
 
 }  // namespace evldt

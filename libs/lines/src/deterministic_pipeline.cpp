@@ -11,8 +11,9 @@ DeterministicPipeline::DeterministicPipeline(const PipelineConfig& config, bool 
       filters_(config.filters, config.lattice.sensor),
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha, keep_surface),
       lines_(lattice_.geometry(), config.track.reassociation),
-      detector_(lattice_.geometry(), config.score),
-      tracker_(lattice_.geometry(), config.score, config.track) {
+      pool_(config.threads),
+      detector_(lattice_.geometry(), config.score, &pool_),
+      tracker_(lattice_.geometry(), config.score, config.track, &pool_) {
   if (config.schedule.track_period_us <= 0 || config.schedule.detect_period_us <= 0) {
     throw std::invalid_argument("tracking and detection periods must be positive");
   }

@@ -18,8 +18,9 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
       detect_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
       track_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
       lines_(lattice_.geometry(), config.track.reassociation),
-      detector_(lattice_.geometry(), config.score),
-      tracker_(lattice_.geometry(), config.score, config.track) {}
+      pool_(config.threads),
+      detector_(lattice_.geometry(), config.score, &pool_),
+      tracker_(lattice_.geometry(), config.score, config.track, &pool_) {}
 
 RealtimeEngine::~RealtimeEngine() { stop(); }
 

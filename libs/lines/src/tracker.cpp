@@ -62,66 +62,108 @@ EndpointMotion endpoint_motion(const Point2& endpoint, const Point2& segment_dir
   return {Point2(line_x, endpoint.y()), Point2(0.0f, perturbation_px)};
 }
 
-LineTracker::LineTracker(const LatticeGeometry& geometry, const ScoreParams& score, const TrackParams& track)
-    : geometry_(geometry),
-      score_params_(score),
-      params_(track),
-      scorer_(score.inlier_distance_ratio * static_cast<float>(geometry.block_size),
-              std::hypot(static_cast<float>(geometry.sensor.width), static_cast<float>(geometry.sensor.height))) {
-  cells_.reserve(static_cast<std::size_t>(geometry.blocks_x + geometry.blocks_y + 2));
-  points_.reserve(cells_.capacity() * static_cast<std::size_t>(geometry.capacity));
+namespace {
+constexpr std::uint8_t kKept = 255;
+static_assert(kReleaseReasonCount < kKept);
+constexpr std::size_t kLinesPerClaim = 16;  // lines a worker claims at a time
+}  // namespace
+
+LineTracker::LineTracker(const LatticeGeometry& geometry, const ScoreParams& score, const TrackParams& track,
+                         WorkerPool* pool)
+    : geometry_(geometry), score_params_(score), params_(track), pool_(pool) {
+  const int threads = pool ? pool->threads() : 1;
+  const float inlier_distance = score.inlier_distance_ratio * static_cast<float>(geometry.block_size);
+  const float diagonal = std::hypot(static_cast<float>(geometry.sensor.width), static_cast<float>(geometry.sensor.height));
+  const auto longest_walk = static_cast<std::size_t>(geometry.blocks_x + geometry.blocks_y + 2);
+  workers_.reserve(static_cast<std::size_t>(threads));
+  for (int w = 0; w < threads; ++w) {
+    Worker& worker = workers_.emplace_back(Worker{FittingScorer(inlier_distance, diagonal), {}, {}, 0});
+    worker.cells.reserve(longest_walk);
+    worker.points.reserve(longest_walk * static_cast<std::size_t>(geometry.capacity));
+  }
+  outcome_.reserve(static_cast<std::size_t>(geometry.block_count()));  // at most one line per block
+}
+
+std::uint64_t LineTracker::settled_passes() const {
+  std::uint64_t passes = 0;
+  for (const Worker& worker : workers_) passes += worker.settled_passes;
+  return passes;
 }
 
 void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp now) {
   auto& all = lines.lines();
   const bool settled_ok = lattice.versions_of() == versions_of_;
   versions_of_ = lattice.versions_of();
-  std::size_t i = 0;
-  while (i < all.size()) {
-    ReleaseReason reason{};
-    if (track_line(lattice, all[i], now, settled_ok, reason)) {
-      ++i;
-    } else {
-      lines.release(i, reason);  // the last line moves into slot i and is tracked next
+  // Every line's pass reads the lattice and writes only the line, so workers share the list freely.
+  const std::size_t n = all.size();
+  outcome_.resize(n);
+  next_line_.store(0, std::memory_order_relaxed);
+  auto track_claimed = [&](int w) {
+    Worker& worker = workers_[static_cast<std::size_t>(w)];
+    for (;;) {
+      const std::size_t begin = next_line_.fetch_add(kLinesPerClaim, std::memory_order_relaxed);
+      if (begin >= n) return;
+      for (std::size_t i = begin; i < std::min(n, begin + kLinesPerClaim); ++i) {
+        ReleaseReason reason{};
+        outcome_[i] = track_line(lattice, all[i], now, settled_ok, worker, reason) ? kKept : static_cast<std::uint8_t>(reason);
+      }
     }
+  };
+  if (pool_ != nullptr && n >= kMinLinesToSplit) {
+    pool_->run(track_claimed);
+  } else {
+    track_claimed(0);
+  }
+  // Release as one pass down the list does: the last line moves into a released line's slot.
+  std::size_t i = 0;
+  while (i < outcome_.size()) {
+    if (outcome_[i] == kKept) {
+      ++i;
+      continue;
+    }
+    lines.release(i, static_cast<ReleaseReason>(outcome_[i]));
+    outcome_[i] = outcome_.back();
+    outcome_.pop_back();
   }
   lines.manage(kSuppressRatio);
 }
 
-bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, bool settled_ok,
-                             ReleaseReason& reason) {
+bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, bool settled_ok, Worker& worker,
+                             ReleaseReason& reason) const {
   const float b = static_cast<float>(geometry_.block_size);
   if (line.segment.length() < 0.5f * b) {
     reason = ReleaseReason::TooShort;
     return false;
   }
-  cells_.clear();
-  blocks_along(line.segment, geometry_, cells_);
-  if (cells_.empty()) {
+  std::vector<int>& cells = worker.cells;
+  cells.clear();
+  blocks_along(line.segment, geometry_, cells);
+  if (cells.empty()) {
     reason = ReleaseReason::LeftSensor;
     return false;
   }
   std::uint64_t newest = 0;
-  for (const int cell : cells_) newest = std::max(newest, lattice.version(cell));
+  for (const int cell : cells) newest = std::max(newest, lattice.version(cell));
   if (settled_ok && line.settled_version != 0 && line.settled_version == newest) {
-    ++settled_passes_;
+    ++worker.settled_passes;
     return judge(line, now, reason);
   }
   line.settled_version = 0;
   int active = 0;
-  for (const int cell : cells_) active += lattice.active_count(cell);
+  for (const int cell : cells) active += lattice.active_count(cell);
   if (active < geometry_.min_points()) {
     reason = ReleaseReason::TooFewPoints;
     return false;
   }
 
   // Event set: one block lends its inactive entries too, so a line can follow an edge leaving it.
-  const bool single_block = cells_.size() == 1;
-  points_.clear();
-  for (const int cell : cells_) points_.add(lattice.entries(cell), /*include_inactive=*/single_block);
+  const bool single_block = cells.size() == 1;
+  PointSet& points = worker.points;
+  points.clear();
+  for (const int cell : cells) points.add(lattice.entries(cell), /*include_inactive=*/single_block);
   float normaliser = static_cast<float>(geometry_.capacity);
   if (!single_block && params_.multi_block_norm == EffectiveRatioNorm::Union) {
-    normaliser *= static_cast<float>(cells_.size());
+    normaliser *= static_cast<float>(cells.size());
   }
 
   const Point2 direction = (line.segment.q1 - line.segment.q0).normalized();
@@ -137,9 +179,9 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Tim
       {inside(m0.base - m0.step), inside(m1.base - m1.step)},
   }};
   std::size_t best = 0;
-  ScoreBreakdown best_score = scorer_.score(hypotheses[0], points_, normaliser);
+  ScoreBreakdown best_score = worker.scorer.score(hypotheses[0], points, normaliser);
   for (std::size_t h = 1; h < hypotheses.size(); ++h) {
-    const ScoreBreakdown s = scorer_.score(hypotheses[h], points_, normaliser);
+    const ScoreBreakdown s = worker.scorer.score(hypotheses[h], points, normaliser);
     if (s.better_than(best_score)) {  // strict: a full tie keeps the current segment
       best_score = s;
       best = h;

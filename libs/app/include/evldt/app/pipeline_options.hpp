@@ -24,7 +24,7 @@ class PipelineOptions {
   [[nodiscard]] Timestamp time_slack_us() const { return time_slack_us_; }
 
  private:
-  std::optional<int> width_, height_, block_size_, fit_iterations_;
+  std::optional<int> width_, height_, block_size_, fit_iterations_, threads_;
   std::optional<double> alpha_;
   std::optional<float> fit_threshold_, inlier_ratio_, perturbation_, reassociation_angle_, reassociation_offset_;
   std::optional<float> whole_angle_, whole_offset_, whole_gap_, whole_min_length_, whole_corner_reach_, whole_corner_angle_;

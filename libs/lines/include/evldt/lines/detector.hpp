@@ -3,29 +3,52 @@
 // fitting score clears the threshold. A block whose entries have not changed since it last failed
 // is skipped: the fit and the score depend on nothing else, so it would fail again.
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
 #include "evldt/lines/fitting_score.hpp"
 #include "evldt/lines/line_map.hpp"
 #include "evldt/lines/params.hpp"
+#include "evldt/lines/worker_pool.hpp"
 
 namespace evldt {
 
 class LineDetector {
  public:
-  LineDetector(const LatticeGeometry& geometry, const ScoreParams& params);
+  /// With a pool, a round's block rows are shared out among its workers (no two touch one block);
+  /// the lines are then created in block order, so the output is the same for any count. The pool
+  /// must outlive the detector.
+  LineDetector(const LatticeGeometry& geometry, const ScoreParams& params, WorkerPool* pool = nullptr);
 
   /// One detection round over every block; returns the number of lines created.
   int detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now);
 
+  /// A lattice of fewer blocks is detected on the calling thread: waking the pool would cost more.
+  static constexpr int kMinBlocksToSplit = 1024;
+
  private:
+  /// One worker's scratch.
+  struct Worker {
+    FittingScorer scorer;
+    PointSet points;  // the active entries of the current block
+  };
+  /// A block's new line of this round, until it is added.
+  struct Found {
+    bool present = false;
+    float score = 0;
+    Segment segment;
+  };
+  void detect_row(const ScarfLattice& lattice, LineMap& lines, int row, Worker& worker);
+
   LatticeGeometry geometry_;
   ScoreParams params_;
-  FittingScorer scorer_;
-  PointSet points_;  // scratch: the active entries of the current block
-  std::uint64_t versions_of_ = 0;               // the lattice whose block versions failed_at_ holds
-  std::vector<std::uint64_t> failed_at_;        // per block: its version at its last failed attempt
+  WorkerPool* pool_;
+  std::vector<Worker> workers_;
+  std::uint64_t versions_of_ = 0;         // the lattice whose block versions failed_at_ holds
+  std::vector<std::uint64_t> failed_at_;  // per block: its version at its last failed attempt
+  std::vector<Found> found_;              // per block
+  std::atomic<int> next_row_{0};          // the next row a worker claims
 };
 
 }  // namespace evldt

@@ -60,6 +60,7 @@ class DeterministicPipeline {
   EventBatch filtered_;  // what passed the filters, reused
   ScarfLattice lattice_;
   LineMap lines_;
+  WorkerPool pool_;  // config.threads; shared by the detector and the tracker
   LineDetector detector_;
   LineTracker tracker_;
   PipelineCounters counters_;

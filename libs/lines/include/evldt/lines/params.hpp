@@ -75,6 +75,9 @@ struct PipelineConfig {
   TrackParams track;
   ScheduleParams schedule;
   WholeLineParams whole_lines;
+  /// Threads a tracking or detection round is split over (a worker pool): the output is the same
+  /// for any count.
+  int threads = 1;
 };
 
 /// DESIGN section 5 defaults for a sensor: b and dq from the nearest listed resolution, dq scaled by width.

@@ -74,6 +74,7 @@ class RealtimeEngine {
 
   mutable std::mutex lines_mutex_;
   LineMap lines_;                             // guarded by lines_mutex_
+  WorkerPool pool_;                           // config.threads: the loops take turns with it
   LineDetector detector_;                     // used only under lines_mutex_
   LineTracker tracker_;                       // used only under lines_mutex_
   Timestamp lines_time_us_ = 0;               // guarded by lines_mutex_

@@ -3,11 +3,14 @@
 // perturbations along the lattice lines its endpoints sit on, keeps the best-scoring one, and the
 // manager then settles ownership and suppression.
 
+#include <atomic>
+#include <cstdint>
 #include <vector>
 
 #include "evldt/lines/fitting_score.hpp"
 #include "evldt/lines/line_map.hpp"
 #include "evldt/lines/params.hpp"
+#include "evldt/lines/worker_pool.hpp"
 
 namespace evldt {
 
@@ -30,29 +33,45 @@ inline constexpr float kSuppressRatio = 0.4f;
 
 class LineTracker {
  public:
-  LineTracker(const LatticeGeometry& geometry, const ScoreParams& score, const TrackParams& track);
+  /// With a pool, a round's lines are tracked by its workers; the output is the same for any count.
+  /// The pool must outlive the tracker.
+  LineTracker(const LatticeGeometry& geometry, const ScoreParams& score, const TrackParams& track,
+              WorkerPool* pool = nullptr);
 
   /// One tracking round over every line, followed by the manager. A line whose blocks have not
   /// changed since a pass that left it in place is not scored again: the pass would repeat itself.
   void track(const ScarfLattice& lattice, LineMap& lines, Timestamp now);
   /// Line passes that reused a settled line's score instead of scoring it again.
-  [[nodiscard]] std::uint64_t settled_passes() const { return settled_passes_; }
+  [[nodiscard]] std::uint64_t settled_passes() const;
+
+  /// A round with fewer lines runs on the calling thread: waking the pool would cost more.
+  static constexpr std::size_t kMinLinesToSplit = 64;
 
  private:
+  /// One worker's scratch.
+  struct Worker {
+    FittingScorer scorer;
+    std::vector<int> cells;  // blocks under the current line
+    PointSet points;         // the event set of the current line
+    std::uint64_t settled_passes = 0;
+  };
   /// Tracks one line; false when it must be released (reason set). settled_ok: versions of this
   /// lattice may be compared with those the lines were settled at.
-  bool track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, bool settled_ok, ReleaseReason& reason);
+  bool track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, bool settled_ok, Worker& worker,
+                  ReleaseReason& reason) const;
   /// Status after a pass that left line.score: good, or bad and released once out of patience.
   bool judge(TrackedLine& line, Timestamp now, ReleaseReason& reason) const;
 
   LatticeGeometry geometry_;
   ScoreParams score_params_;
   TrackParams params_;
-  FittingScorer scorer_;
-  std::vector<int> cells_;               // scratch: blocks under the current line
-  PointSet points_;                      // scratch: the event set of the current line
-  std::uint64_t versions_of_ = 0;        // ScarfLattice::versions_of() at the last round
-  std::uint64_t settled_passes_ = 0;
+  WorkerPool* pool_;
+  std::vector<Worker> workers_;
+  /// Per line of the round: kKept, or the ReleaseReason it ends with. Lines are tracked first and
+  /// released after, in the order one pass down the list would release them.
+  std::vector<std::uint8_t> outcome_;
+  std::atomic<std::size_t> next_line_{0};  // the next line a worker claims
+  std::uint64_t versions_of_ = 0;          // ScarfLattice::versions_of() at the last round
 };
 
 }  // namespace evldt
