@@ -59,8 +59,9 @@ field() {  # field FILE REGEX: the first number after REGEX
   grep -oP "$2\s*\K[0-9.]+" "$1" | head -1
 }
 
-printf 'scene %s, %s s per speed, segment lists at %s Hz, %s\n' "$scene" "$seconds" "$publish_hz" "$url"
-printf '%-7s %10s %14s %11s %11s %10s %14s\n' speed "Mev/s" "batches lost" "camera CPU" "lines CPU" "B/event" "latency ms"
+printf 'scene %s, %s s per speed, segment lists at %s Hz, %s, evldt-lines %s\n' "$scene" "$seconds" "$publish_hz" "$url" \
+  "${lines_args[*]:-(defaults)}"
+printf '%-7s %10s %14s %11s %11s %8s %10s %14s\n' speed "Mev/s" "batches lost" "camera CPU" "lines CPU" threads "B/event" "latency ms"
 rows=()
 best=0
 for speed in $speeds; do
@@ -89,8 +90,9 @@ for speed in $speeds; do
   p99=$(field "$work/lines.out" 'p99')
   camera_pct=$(awk -v c="$camera_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
   lines_pct=$(awk -v c="$lines_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
-  printf '%-7s %10s %14s %11s %11s %10s %14s\n' "$speed" "$rate" "$lost of $received" "$camera_pct" "$lines_pct" "$bytes" "$median / $p99"
-  rows+=("{\"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99}")
+  threads=$(field "$work/lines.err" 'rounds on')
+  printf '%-7s %10s %14s %11s %11s %8s %10s %14s\n' "$speed" "$rate" "$lost of $received" "$camera_pct" "$lines_pct" "$threads" "$bytes" "$median / $p99"
+  rows+=("{\"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"threads\": $threads, \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99}")
   if [[ $lost == 0 ]] && awk -v r="$rate" -v b="$best" -v p="$p99" -v m="$max_p99_ms" 'BEGIN { exit !(r > b && p < m) }'; then
     best=$rate
   fi

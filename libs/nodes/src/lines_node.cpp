@@ -83,6 +83,7 @@ void LinesNode::start_engine() {
                  sensor.height, receiver_.message().source);
   }
   auto engine = std::make_shared<RealtimeEngine>(options_.configure(*receiver_.sensor()));
+  spdlog::info("engine: b={}, rounds on {} thread(s)", engine->config().lattice.block_size, engine->config().threads);
   engine->set_first_line_id(next_line_id_ + retired.lines_created);
   engine->start();
   std::lock_guard lock(mutex_);
