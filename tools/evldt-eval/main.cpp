@@ -89,7 +89,6 @@ StreamEvaluator evaluate_files(const Options& options, SensorSize sensor, const 
   const bool from_log = is_lcm_log(options.segments);
   std::vector<SegmentRow> rows =
       from_log ? read_segment_log(options.segments, options.lcm_channel) : read_segment_csv(options.segments);
-  std::stable_sort(rows.begin(), rows.end(), [](const SegmentRow& a, const SegmentRow& b) { return a.t_us < b.t_us; });
   GroundTruthSteps truth = sim.scene_selected() ? scene_ground_truth_steps(sim.scene(), options.step_us)
                                                 : csv_ground_truth_steps(read_ground_truth_csv(options.ground_truth));
   if (from_log) {
@@ -101,28 +100,7 @@ StreamEvaluator evaluate_files(const Options& options, SensorSize sensor, const 
                    static_cast<double>(span->second) * 1e-6);
     }
   }
-  std::vector<Timestamp> times;
-  for (const SegmentRow& row : rows) {
-    if (times.empty() || times.back() != row.t_us) times.push_back(row.t_us);
-  }
-  Timestamp period = options.output_period_us > 0 ? options.output_period_us : median_step_spacing(times);
-  if (period == 0) period = median_step_spacing(truth.times);  // fewer than two predicted steps
-  StreamEvaluator evaluator(sensor, options.tolerances, std::move(truth),
-                            std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(period)));
-  std::vector<std::uint64_t> ids;
-  std::vector<Segment> predicted;
-  for (std::size_t i = 0; i < rows.size();) {
-    const Timestamp t = rows[i].t_us;
-    ids.clear();
-    predicted.clear();
-    for (; i < rows.size() && rows[i].t_us == t; ++i) {
-      ids.push_back(rows[i].id);
-      predicted.push_back(rows[i].segment);
-    }
-    evaluator.add_prediction(t, ids, predicted);
-  }
-  evaluator.finish();
-  return evaluator;
+  return evaluate_segment_rows(std::move(rows), std::move(truth), sensor, options.tolerances, options.output_period_us);
 }
 
 // An undefined ratio (nothing predicted, or no ground truth) is "n/a", never a perfect or zero score.

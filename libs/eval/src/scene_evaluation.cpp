@@ -118,6 +118,33 @@ void StreamEvaluator::finish() {
   coverage_.predicted_steps_scored += held_scored_ ? 1 : 0;
 }
 
+StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthSteps truth, SensorSize sensor,
+                                      std::vector<double> tolerance_fractions, Timestamp output_period_us) {
+  std::stable_sort(rows.begin(), rows.end(), [](const SegmentRow& a, const SegmentRow& b) { return a.t_us < b.t_us; });
+  std::vector<Timestamp> times;
+  for (const SegmentRow& row : rows) {
+    if (times.empty() || times.back() != row.t_us) times.push_back(row.t_us);
+  }
+  Timestamp period = output_period_us > 0 ? output_period_us : median_step_spacing(times);
+  if (period == 0) period = median_step_spacing(truth.times);  // fewer than two predicted steps
+  StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth),
+                            std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(period)));
+  std::vector<std::uint64_t> ids;
+  std::vector<Segment> predicted;
+  for (std::size_t i = 0; i < rows.size();) {
+    const Timestamp t = rows[i].t_us;
+    ids.clear();
+    predicted.clear();
+    for (; i < rows.size() && rows[i].t_us == t; ++i) {
+      ids.push_back(rows[i].id);
+      predicted.push_back(rows[i].segment);
+    }
+    evaluator.add_prediction(t, ids, predicted);
+  }
+  evaluator.finish();
+  return evaluator;
+}
+
 StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tolerance_fractions, Timestamp step_us) {
   return StreamEvaluator(scene.sensor, std::move(tolerance_fractions), scene_ground_truth_steps(scene, step_us),
                          std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(step_us)));

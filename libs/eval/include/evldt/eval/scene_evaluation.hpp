@@ -11,6 +11,7 @@
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/eval/tracking_metrics.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
+#include "evldt/lines/segment_csv.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
 
@@ -88,6 +89,13 @@ class StreamEvaluator {
   StepCoverage coverage_;
   bool finished_ = false;
 };
+
+/// Scores predicted segment rows (of a CSV, a log or Python; any order, sorted by time here) on
+/// ground-truth steps with StreamEvaluator's rule and a hold of kHoldPeriods output periods.
+/// output_period_us 0: the median spacing of the predicted steps (of the ground truth's, with fewer
+/// than two).
+StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthSteps truth, SensorSize sensor,
+                                      std::vector<double> tolerance_fractions, Timestamp output_period_us);
 
 /// The nominal output period of a prediction: the median spacing of its distinct step times, or 0
 /// with fewer than two.
