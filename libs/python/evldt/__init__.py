@@ -1,0 +1,146 @@
+"""evldt from Python: recording readers, the deterministic line pipeline, the evaluator and the
+simulator of the C++ core, on numpy arrays; and the LCM message types (evldt.segment_list_t, ...).
+
+    import evldt
+    events, width, height, fmt = evldt.read("recording.raw")
+    pipeline = evldt.Pipeline(width, height)
+    steps = pipeline.process(events)          # the segments of every 10 ms output step
+    print(steps[steps["t"] == steps["t"].max()])
+
+Parameters are the command-line flags of the tools, with underscores (block_size=14 is
+--block-size 14) and checked as the tools check them; a bad one raises ValueError with their
+message. Long calls release the GIL.
+"""
+
+from collections import namedtuple
+
+import numpy as np
+
+from ._evldt import (EVENT_DTYPE, GROUND_TRUTH_DTYPE, SEGMENT_DTYPE, FormatError, Reader)
+from . import _evldt
+from .event_batch_t import event_batch_t
+from .line_segment_t import line_segment_t
+from .segment_list_t import segment_list_t
+from .stats_t import stats_t
+
+__all__ = ["read", "read_chunks", "Recording", "Pipeline", "evaluate", "simulate", "Simulation", "EVENT_DTYPE",
+           "SEGMENT_DTYPE", "GROUND_TRUTH_DTYPE", "STATUS_NAMES", "FormatError", "event_batch_t",
+           "line_segment_t", "segment_list_t", "stats_t"]
+
+#: SEGMENT_DTYPE's status codes.
+STATUS_NAMES = ("detected", "good", "bad")
+
+Recording = namedtuple("Recording", "events width height format")
+Simulation = namedtuple("Simulation", "events ground_truth width height")
+
+
+def _flags(params):
+    """Keyword parameters as the tools' command-line flags."""
+    flags = []
+    for name, value in params.items():
+        if value is None:
+            continue
+        if isinstance(value, (list, tuple)):
+            value = ",".join(str(v) for v in value)
+        flags += ["--" + name.replace("_", "-"), str(value)]
+    return flags
+
+
+def read_chunks(path, chunk_events=1_000_000, format=None, channel="", time_slack_us=1000):
+    """Yields the events of a recording as structured arrays (EVENT_DTYPE: t, x, y, p) of about
+    chunk_events each, in file order: every format evldt-offline reads. A corrupt file raises
+    FormatError after the chunks before the fault."""
+    if chunk_events < 1:
+        raise ValueError("chunk_events must be at least 1")
+    reader = Reader(str(path), format or "", channel, time_slack_us)
+    while True:
+        chunk = reader.read(chunk_events)
+        if chunk is None:
+            return
+        yield chunk
+
+
+def read(path, format=None, channel="", time_slack_us=1000):
+    """A whole recording: Recording(events, width, height, format), where width and height are
+    None when the file does not say and format names the reader (as evldt-offline logs it)."""
+    reader = Reader(str(path), format or "", channel, time_slack_us)
+    chunks = []
+    while True:
+        chunk = reader.read(1 << 22)
+        if chunk is None:
+            break
+        chunks.append(chunk)
+    events = np.concatenate(chunks) if chunks else np.empty(0, dtype=EVENT_DTYPE)
+    width, height = reader.sensor if reader.sensor is not None else (None, None)
+    return Recording(events, width, height, reader.name)
+
+
+def _column(values, dtype, name):
+    """A column as `dtype`, without a copy where it already is; values out of range raise
+    ValueError instead of wrapping around."""
+    array = np.asarray(values)
+    if array.dtype == dtype:
+        return array
+    if not np.issubdtype(array.dtype, np.integer):
+        raise ValueError(f"{name} must be integers, not {array.dtype}")
+    info = np.iinfo(dtype)
+    if array.size and (array.min() < info.min or array.max() > info.max):
+        raise ValueError(f"{name} values must lie in [{info.min}, {info.max}]")
+    return array.astype(dtype)
+
+
+class Pipeline:
+    """The deterministic pipeline of evldt-offline (validation, noise filters, SCARF storage,
+    detection, tracking) for a width x height sensor. process() returns the segments of each output
+    step (every output_period_us of event time) the events completed, as a SEGMENT_DTYPE array:
+    the rows evldt-offline writes to its CSV for the same events and parameters."""
+
+    def __init__(self, width, height, output_period_us=10_000, config=None, **params):
+        if config is not None:
+            params["config"] = str(config)
+        self._impl = _evldt.Pipeline(int(width), int(height), _flags(params), int(output_period_us))
+
+    def process(self, events, x=None, y=None, p=None):
+        """process(events) with a structured array (fields t, x, y, p), or process(t, x, y, p)."""
+        if x is None:
+            events = np.asarray(events)
+            if events.dtype.names is None or not {"t", "x", "y", "p"} <= set(events.dtype.names):
+                raise ValueError("events must be a structured array with fields t, x, y, p (or pass t, x, y, p)")
+            t, x, y, p = events["t"], events["x"], events["y"], events["p"]
+        else:
+            t = events
+        return self._impl.process(_column(t, np.int64, "t"), _column(x, np.uint16, "x"), _column(y, np.uint16, "y"),
+                                  _column(p, np.int8, "p"))
+
+    def segments(self):
+        """The live segments now (SEGMENT_DTYPE, t = the newest event time)."""
+        return self._impl.segments()
+
+    def counters(self):
+        """Events accepted and dropped, rounds run, lines created and live."""
+        return self._impl.counters()
+
+
+def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), output_period_us=0):
+    """evldt-eval's figures for predicted segments (SEGMENT_DTYPE, or any structured array with t,
+    id, x0, y0, x1, y1) against ground truth (GROUND_TRUTH_DTYPE: t, gt_id, x0, y0, x1, y1):
+    precision, recall and F at each tolerance (a fraction of the image diagonal), id lifetimes and
+    the tracking metrics. output_period_us 0: the median spacing of the predicted steps."""
+    predicted = np.zeros(len(segments), dtype=SEGMENT_DTYPE)
+    for field in ("t", "id", "x0", "y0", "x1", "y1"):
+        predicted[field] = segments[field]
+    truth = np.zeros(len(ground_truth), dtype=GROUND_TRUTH_DTYPE)
+    for field in GROUND_TRUTH_DTYPE.names:
+        truth[field] = ground_truth[field]
+    return _evldt.evaluate(predicted, truth, int(width), int(height), [float(t) for t in tolerances],
+                           int(output_period_us))
+
+
+def simulate(scene, gt_period_us=10_000, **options):
+    """A built-in scene (the names evldt-sim --list gives) through the event simulator:
+    Simulation(events, ground_truth, width, height). Options are evldt-sim's flags (duration_s,
+    seed, motion_seed, contrast, noise_rate_hz, ...)."""
+    if gt_period_us < 1:
+        raise ValueError("gt_period_us must be at least 1")
+    events, truth, width, height = _evldt.simulate(["--scene", str(scene)] + _flags(options), int(gt_period_us))
+    return Simulation(events, truth, width, height)

@@ -1,0 +1,351 @@
+// _evldt: the Python face of the core (package evldt wraps it). Wiring only: every figure comes from
+// the same libraries the tools use, and options go through the tools' own option parsers, so a
+// parameter means, and is checked, as on the command line.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "evldt/app/pipeline_options.hpp"
+#include "evldt/app/simulator_options.hpp"
+#include "evldt/eval/scene_evaluation.hpp"
+#include "evldt/events/event_validator.hpp"
+#include "evldt/lines/deterministic_pipeline.hpp"
+#include "evldt/sources/event_source.hpp"
+
+namespace py = pybind11;
+
+namespace evldt::python {
+
+// Packed records: numpy's own dtype for a list of fields has no padding, so arrays built in Python
+// (and np.concatenate's results) have the same dtype as the module's.
+#pragma pack(push, 1)
+/// One event as numpy holds it (the dtype evldt.EVENT_DTYPE).
+struct EventRecord {
+  std::int64_t t;
+  std::uint16_t x;
+  std::uint16_t y;
+  std::int8_t p;
+};
+
+/// One segment at one output step (evldt.SEGMENT_DTYPE): the columns of evldt-offline's CSV, and
+/// the line's first-seen and last-good times.
+struct SegmentRecord {
+  std::int64_t t;
+  std::uint64_t id;
+  float x0, y0, x1, y1;
+  float score;
+  std::uint8_t status;  ///< 0 detected, 1 good, 2 bad (evldt.STATUS_NAMES)
+  std::int64_t first_seen;
+  std::int64_t last_good;
+};
+
+/// One ground-truth edge piece at one step (evldt.GROUND_TRUTH_DTYPE), as evldt-sim's CSV has it.
+struct GroundTruthRecord {
+  std::int64_t t;
+  std::int64_t gt_id;
+  double x0, y0, x1, y1;
+};
+#pragma pack(pop)
+
+namespace {
+
+/// Parses `args` (command-line flags) with an app set up by `add`; a usage error raises ValueError
+/// with CLI11's message, as the tools print it.
+template <typename Add>
+void parse_flags(const std::string& what, const std::vector<std::string>& args, Add add) {
+  CLI::App app{what};
+  add(app);
+  std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
+  try {
+    app.parse(reversed);
+  } catch (const CLI::ParseError& error) {
+    throw py::value_error(std::string(error.what()));
+  }
+}
+
+template <typename Record>
+py::array_t<Record> to_numpy(const std::vector<Record>& records) {
+  py::array_t<Record> out(static_cast<py::ssize_t>(records.size()));
+  if (!records.empty()) std::memcpy(out.mutable_data(), records.data(), records.size() * sizeof(Record));
+  return out;
+}
+
+py::array_t<EventRecord> events_to_numpy(const EventBatch& batch) {
+  py::array_t<EventRecord> out(static_cast<py::ssize_t>(batch.size()));
+  auto view = out.mutable_unchecked<1>();
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    view(static_cast<py::ssize_t>(i)) = {batch.t[i], batch.x[i], batch.y[i], batch.p[i]};
+  }
+  return out;
+}
+
+/// A step's lines, by id as in evldt-offline's CSV.
+void append_lines(Timestamp t, const std::vector<TrackedLine>& lines, std::vector<SegmentRecord>& out) {
+  const std::size_t first = out.size();
+  for (const TrackedLine& line : lines) {
+    out.push_back({t, line.id, line.segment.q0.x(), line.segment.q0.y(), line.segment.q1.x(), line.segment.q1.y(),
+                   line.score, static_cast<std::uint8_t>(line.status), line.first_seen_us, line.last_good_us});
+  }
+  std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(),
+            [](const SegmentRecord& a, const SegmentRecord& b) { return a.id < b.id; });
+}
+
+/// A recording read in chunks (evldt.read_chunks; evldt.read joins them).
+class Reader {
+ public:
+  Reader(const std::string& path, const std::string& format, const std::string& channel, Timestamp time_slack_us) {
+    std::optional<EventFormat> parsed;
+    if (!format.empty()) {
+      parsed = parse_event_format(format);
+      if (!parsed) throw py::value_error("unknown format '" + format + "': ecd, evt2, evt3, evt21, dat");
+    }
+    source_ = open_recording(path, parsed, channel, time_slack_us);
+  }
+
+  /// The next `max_events` events (fewer only at the end); None at the end.
+  std::optional<py::array_t<EventRecord>> read(std::size_t max_events) {
+    {
+      py::gil_scoped_release unlocked;
+      chunk_.clear();
+      while (chunk_.size() < max_events) {
+        if (taken_ == pending_.size()) {
+          taken_ = 0;
+          if (!source_->read(pending_)) break;
+        }
+        const std::size_t n = std::min(max_events - chunk_.size(), pending_.size() - taken_);
+        const auto from = static_cast<std::ptrdiff_t>(taken_), to = static_cast<std::ptrdiff_t>(taken_ + n);
+        chunk_.t.insert(chunk_.t.end(), pending_.t.begin() + from, pending_.t.begin() + to);
+        chunk_.x.insert(chunk_.x.end(), pending_.x.begin() + from, pending_.x.begin() + to);
+        chunk_.y.insert(chunk_.y.end(), pending_.y.begin() + from, pending_.y.begin() + to);
+        chunk_.p.insert(chunk_.p.end(), pending_.p.begin() + from, pending_.p.begin() + to);
+        taken_ += n;
+      }
+    }
+    if (chunk_.empty()) return std::nullopt;
+    return events_to_numpy(chunk_);
+  }
+
+  [[nodiscard]] std::optional<std::pair<int, int>> sensor() const {
+    const auto size = source_->geometry();
+    if (!size) return std::nullopt;
+    return std::pair(size->width, size->height);
+  }
+  [[nodiscard]] std::string name() const { return source_->name(); }
+  [[nodiscard]] double progress() const { return source_->progress(); }
+
+ private:
+  std::unique_ptr<EventSource> source_;
+  EventBatch pending_;     // the source's last batch
+  std::size_t taken_ = 0;  // of pending_, already returned
+  EventBatch chunk_;
+};
+
+/// The deterministic pipeline behind evldt-offline: validation, noise filters, storage, detection
+/// and tracking, with an output step every output_period_us of event time.
+class Pipeline {
+ public:
+  Pipeline(int width, int height, const std::vector<std::string>& flags, Timestamp output_period_us) {
+    PipelineOptions options;
+    parse_flags("evldt.Pipeline", flags, [&](CLI::App& app) { options.add_to(app); });
+    const SensorSize sensor{width, height};
+    if (width < 1 || height < 1 || width > kMaxSensorSide || height > kMaxSensorSide) {
+      throw py::value_error("sensor size must be 1.." + std::to_string(kMaxSensorSide) + " on each side");
+    }
+    const PipelineConfig config = options.resolve(sensor);  // std::invalid_argument -> ValueError
+    validator_.emplace(sensor, options.time_slack_us());
+    pipeline_.emplace(config);
+    pipeline_->set_output(output_period_us, [this](Timestamp t, const LineMap& lines, const ScarfLattice&) {
+      append_lines(t, lines.lines(), steps_);
+    });
+    staging_.reserve(kStagingEvents);
+  }
+
+  /// Runs the events (any length; strided numpy views are read in place) and returns the segments
+  /// of every output step they completed.
+  py::array_t<SegmentRecord> process(const py::array_t<std::int64_t>& t, const py::array_t<std::uint16_t>& x,
+                                     const py::array_t<std::uint16_t>& y, const py::array_t<std::int8_t>& p) {
+    if (t.ndim() != 1 || x.ndim() != 1 || y.ndim() != 1 || p.ndim() != 1) {
+      throw py::value_error("t, x, y and p must be one-dimensional");
+    }
+    const py::ssize_t n = t.shape(0);
+    if (x.shape(0) != n || y.shape(0) != n || p.shape(0) != n) throw py::value_error("t, x, y and p must have one length");
+    const auto ts = t.unchecked<1>();
+    const auto xs = x.unchecked<1>();
+    const auto ys = y.unchecked<1>();
+    const auto ps = p.unchecked<1>();
+    steps_.clear();
+    {
+      py::gil_scoped_release unlocked;  // the arrays stay alive: the caller holds them
+      for (py::ssize_t begin = 0; begin < n; begin += static_cast<py::ssize_t>(kStagingEvents)) {
+        const py::ssize_t end = std::min(n, begin + static_cast<py::ssize_t>(kStagingEvents));
+        staging_.clear();
+        for (py::ssize_t i = begin; i < end; ++i) staging_.push_back(ts(i), xs(i), ys(i), ps(i));
+        validator_->filter(staging_);
+        pipeline_->process(staging_);
+      }
+    }
+    return to_numpy(steps_);
+  }
+
+  /// The live lines now, stamped with the newest event time seen.
+  py::array_t<SegmentRecord> segments() const {
+    std::vector<SegmentRecord> now;
+    append_lines(validator_->newest_time(), pipeline_->lines().lines(), now);
+    return to_numpy(now);
+  }
+
+  py::dict counters() const {
+    py::dict out;
+    const auto& c = pipeline_->counters();
+    const auto& lines = pipeline_->lines();
+    out["events_accepted"] = validator_->accepted();
+    out["dropped_off_sensor"] = validator_->drops().off_sensor;
+    out["dropped_back_in_time"] = validator_->drops().time_backwards;
+    out["events_stored"] = c.events;
+    out["track_rounds"] = c.track_rounds;
+    out["detect_rounds"] = c.detect_rounds;
+    out["skipped_rounds"] = c.skipped_rounds;
+    out["lines_created"] = lines.created();
+    out["lines_live"] = lines.lines().size();
+    return out;
+  }
+
+ private:
+  // Events are staged in slices this long: the pipeline takes its batch type, and a slice keeps
+  // the staging memory small whatever the input's length.
+  static constexpr std::size_t kStagingEvents = 1 << 16;
+  std::optional<EventValidator> validator_;
+  std::optional<DeterministicPipeline> pipeline_;
+  EventBatch staging_;
+  std::vector<SegmentRecord> steps_;
+};
+
+py::dict prf_dict(const Prf& prf) {
+  py::dict out;
+  out["precision"] = prf.precision;
+  out["recall"] = prf.recall;
+  out["f"] = prf.f;
+  return out;
+}
+
+/// evldt-eval's figures of predicted segments against ground truth.
+py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<GroundTruthRecord>& ground_truth,
+                  int width, int height, const std::vector<double>& tolerances, Timestamp output_period_us) {
+  std::vector<SegmentRow> rows;
+  const auto predicted = segments.unchecked<1>();
+  rows.reserve(static_cast<std::size_t>(predicted.shape(0)));
+  for (py::ssize_t i = 0; i < predicted.shape(0); ++i) {
+    const SegmentRecord& r = predicted(i);
+    rows.push_back({r.t, r.id, Segment{Point2(r.x0, r.y0), Point2(r.x1, r.y1)}, r.score, static_cast<LineStatus>(r.status)});
+  }
+  std::vector<GroundTruthRow> truth_rows;
+  const auto truth = ground_truth.unchecked<1>();
+  for (py::ssize_t i = 0; i < truth.shape(0); ++i) {
+    const GroundTruthRecord& r = truth(i);
+    if (r.gt_id < std::numeric_limits<int>::min() || r.gt_id > std::numeric_limits<int>::max()) {
+      throw py::value_error("ground-truth id out of range at row " + std::to_string(i));
+    }
+    truth_rows.push_back({r.t, GtSegment{static_cast<int>(r.gt_id), Vec2d(r.x0, r.y0), Vec2d(r.x1, r.y1)}});
+  }
+  std::optional<StreamEvaluator> evaluator;
+  {
+    py::gil_scoped_release unlocked;
+    GroundTruthSteps steps = csv_ground_truth_steps(truth_rows);
+    evaluator.emplace(evaluate_segment_rows(std::move(rows), std::move(steps), SensorSize{width, height}, tolerances,
+                                            output_period_us));
+  }
+  py::dict out;
+  py::list by_tolerance;
+  const auto& accuracy = evaluator->accuracy();
+  for (std::size_t i = 0; i < tolerances.size(); ++i) {
+    py::dict entry = prf_dict(accuracy.summed_prf(i));
+    entry["tolerance"] = tolerances[i];
+    by_tolerance.append(entry);
+  }
+  out["accuracy"] = by_tolerance;
+  out["steps"] = accuracy.steps();
+  out["mean_predicted_segments"] = accuracy.mean_predicted_segments();
+  out["mean_ground_truth_segments"] = accuracy.mean_ground_truth_segments();
+  const LifetimeSummary life = evaluator->lifetimes().summary();
+  out["ids"] = life.count;
+  out["lifetime_mean_ms"] = life.mean_ms;
+  out["lifetime_max_ms"] = life.max_ms;
+  const TrackingSummary tracking = evaluator->tracking().summary();
+  out["idf1"] = tracking.idf1;
+  out["id_switches"] = tracking.id_switches;
+  out["ids_per_line"] = tracking.ids_per_line;
+  out["coverage"] = tracking.coverage;
+  out["steps_without_prediction"] = evaluator->coverage().steps_without_prediction;
+  return out;
+}
+
+/// A built-in scene through the event simulator: its events, its ground truth every gt_period_us
+/// (as evldt-sim writes it), and its sensor size.
+py::tuple simulate(const std::vector<std::string>& flags, Timestamp gt_period_us) {
+  SimulatorOptions options;
+  parse_flags("evldt.simulate", flags, [&](CLI::App& app) { options.add_to(app, /*scene_required=*/true); });
+  const Scene scene = options.scene();
+  EventBatch events;
+  std::vector<GroundTruthRecord> truth;
+  {
+    py::gil_scoped_release unlocked;
+    EventSimulator simulator(scene, options.config());
+    while (simulator.run_until(simulator.now_us() + 10'000, events)) {
+    }
+    for (Timestamp t = 0; t <= scene.duration_us; t += gt_period_us) {
+      for (const GtSegment& edge : scene.visible_edges(t)) {
+        truth.push_back({t, edge.gt_id, edge.a.x(), edge.a.y(), edge.b.x(), edge.b.y()});
+      }
+    }
+  }
+  return py::make_tuple(events_to_numpy(events), to_numpy(truth), scene.sensor.width, scene.sensor.height);
+}
+
+}  // namespace
+}  // namespace evldt::python
+
+PYBIND11_MODULE(_evldt, m) {
+  using namespace evldt;
+  using namespace evldt::python;
+  m.doc() = "evldt core: recording readers, the deterministic line pipeline, the evaluator and the simulator";
+  PYBIND11_NUMPY_DTYPE(EventRecord, t, x, y, p);
+  PYBIND11_NUMPY_DTYPE(SegmentRecord, t, id, x0, y0, x1, y1, score, status, first_seen, last_good);
+  PYBIND11_NUMPY_DTYPE(GroundTruthRecord, t, gt_id, x0, y0, x1, y1);
+  // A corrupt recording: what the tools print as the error, after the valid prefix was returned.
+  py::register_exception<FormatError>(m, "FormatError", PyExc_ValueError);
+
+  m.attr("EVENT_DTYPE") = py::dtype::of<EventRecord>();
+  m.attr("SEGMENT_DTYPE") = py::dtype::of<SegmentRecord>();
+  m.attr("GROUND_TRUTH_DTYPE") = py::dtype::of<GroundTruthRecord>();
+
+  py::class_<Reader>(m, "Reader")
+      .def(py::init<const std::string&, const std::string&, const std::string&, Timestamp>(), py::arg("path"),
+           py::arg("format") = "", py::arg("channel") = "", py::arg("time_slack_us") = 1000)
+      .def("read", &Reader::read, py::arg("max_events"))
+      .def_property_readonly("sensor", &Reader::sensor)
+      .def_property_readonly("name", &Reader::name)
+      .def_property_readonly("progress", &Reader::progress);
+
+  py::class_<Pipeline>(m, "Pipeline")
+      .def(py::init<int, int, const std::vector<std::string>&, Timestamp>(), py::arg("width"), py::arg("height"),
+           py::arg("flags"), py::arg("output_period_us"))
+      .def("process", &Pipeline::process, py::arg("t"), py::arg("x"), py::arg("y"), py::arg("p"))
+      .def("segments", &Pipeline::segments)
+      .def("counters", &Pipeline::counters);
+
+  m.def("evaluate", &evaluate, py::arg("segments"), py::arg("ground_truth"), py::arg("width"), py::arg("height"),
+        py::arg("tolerances"), py::arg("output_period_us"));
+  m.def("simulate", &simulate, py::arg("flags"), py::arg("gt_period_us"));
+}

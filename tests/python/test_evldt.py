@@ -1,0 +1,222 @@
+"""The Python module against the C++ tools on the same data: evldt-sim writes the recordings,
+evldt-offline and evldt-eval give the figures the module must reproduce.
+
+Run by tests/run.sh (ctest: python_module) with EVLDT_BUILD set to the build folder and the
+module's folder on PYTHONPATH."""
+
+import csv
+import json
+import os
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+import evldt
+
+BUILD = pathlib.Path(os.environ.get("EVLDT_BUILD", "build/dev"))
+SIM = BUILD / "tools/evldt-sim/evldt-sim"
+OFFLINE = BUILD / "tools/evldt-offline/evldt-offline"
+EVAL = BUILD / "tools/evldt-eval/evldt-eval"
+REAL = pathlib.Path(__file__).resolve().parents[2] / ".." / "shared" / "real"
+
+
+def run(*args, check=True):
+    return subprocess.run([str(a) for a in args], capture_output=True, text=True, check=check)
+
+
+@pytest.fixture(scope="module")
+def boxes(tmp_path_factory):
+    """0.4 s of boxes-6dof, written by evldt-sim in every format it writes."""
+    folder = tmp_path_factory.mktemp("boxes")
+    for fmt in ("evt3", "evt2", "evt21", "dat", "ecd"):
+        run(SIM, "--scene", "boxes-6dof", "--duration-s", "0.4", "--out-dir", folder / fmt, "--format", fmt, "--quiet")
+    return folder
+
+
+def recording(folder, fmt):
+    (path,) = [p for p in (folder / fmt).iterdir() if p.name.startswith("events")]
+    return path
+
+
+def read_csv(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def test_readers_give_the_simulated_events_in_every_format(boxes):
+    simulated = evldt.simulate("boxes-6dof", duration_s=0.4)
+    assert len(simulated.events) > 50_000
+    for fmt in ("evt3", "evt2", "evt21", "dat", "ecd"):
+        got = evldt.read(recording(boxes, fmt))
+        assert got.events.dtype == evldt.EVENT_DTYPE
+        if fmt != "ecd":  # events.txt has no header to say the sensor size
+            assert (got.width, got.height) == (simulated.width, simulated.height), fmt
+        for field in ("t", "x", "y"):
+            np.testing.assert_array_equal(got.events[field], simulated.events[field], err_msg=fmt)
+        np.testing.assert_array_equal(got.events["p"] > 0, simulated.events["p"] > 0, err_msg=fmt)
+
+
+def test_chunks_join_to_the_whole_recording(boxes):
+    path = recording(boxes, "evt3")
+    chunks = list(evldt.read_chunks(path, chunk_events=10_000))
+    assert len(chunks) > 5
+    assert all(len(c) == 10_000 for c in chunks[:-1]) and 0 < len(chunks[-1]) <= 10_000
+    np.testing.assert_array_equal(np.concatenate(chunks), evldt.read(path).events)
+
+
+def test_pipeline_output_equals_evldt_offline_csv(boxes, tmp_path):
+    path = recording(boxes, "evt3")
+    run(OFFLINE, path, "-o", tmp_path / "segments.csv", "-q")
+    expected = read_csv(tmp_path / "segments.csv")
+    rec = evldt.read(path)
+    pipeline = evldt.Pipeline(rec.width, rec.height)
+    # In uneven slices, as a stream arrives: the output may not depend on how the events are cut.
+    cuts = [0, 1, 777, 50_000, 123_457, len(rec.events)]
+    got = np.concatenate([pipeline.process(rec.events[a:b]) for a, b in zip(cuts, cuts[1:])])
+    assert len(expected) > 1000
+    assert len(got) == len(expected)
+    np.testing.assert_array_equal(got["t"], [int(r["t_us"]) for r in expected])
+    np.testing.assert_array_equal(got["id"], [int(r["id"]) for r in expected])
+    for field in ("x0", "y0", "x1", "y1"):
+        np.testing.assert_allclose(got[field], [float(r[field]) for r in expected], rtol=0, atol=5.1e-4)
+    np.testing.assert_allclose(got["score"], [float(r["score"]) for r in expected], rtol=0, atol=5.1e-5)
+    assert [evldt.STATUS_NAMES[s] for s in got["status"]] == [r["status"] for r in expected]
+    assert (got["first_seen"] <= got["t"]).all() and (got["last_good"] <= got["t"]).all()
+    live = pipeline.segments()
+    assert len(live) == pipeline.counters()["lines_live"] > 0
+
+
+def test_pipeline_takes_separate_columns_and_is_deterministic(boxes):
+    events = evldt.read(recording(boxes, "evt3")).events
+    a = evldt.Pipeline(240, 180).process(events)
+    b = evldt.Pipeline(240, 180).process(events["t"], events["x"].astype(np.int32), events["y"], events["p"])
+    np.testing.assert_array_equal(a, b)
+
+
+def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
+    # The same numbers both ways: evldt-offline's CSV and evldt-sim's ground truth, read into numpy.
+    path = recording(boxes, "evt3")
+    truth_csv = boxes / "evt3" / "ground_truth.csv"
+    run(OFFLINE, path, "-o", tmp_path / "segments.csv", "-q")
+    run(EVAL, "--segments", tmp_path / "segments.csv", "--ground-truth", truth_csv, "--width", 240, "--height", 180,
+        "--json", tmp_path / "eval.json")
+    (reference,) = json.loads((tmp_path / "eval.json").read_text())["runs"]
+    rows = read_csv(tmp_path / "segments.csv")
+    segments = np.zeros(len(rows), dtype=evldt.SEGMENT_DTYPE)
+    segments["t"] = [int(r["t_us"]) for r in rows]
+    segments["id"] = [int(r["id"]) for r in rows]
+    for field in ("x0", "y0", "x1", "y1"):
+        segments[field] = np.array([r[field] for r in rows], dtype=np.float32)
+    truth_rows = read_csv(truth_csv)
+    truth = np.zeros(len(truth_rows), dtype=evldt.GROUND_TRUTH_DTYPE)
+    truth["t"] = [int(r["t_us"]) for r in truth_rows]
+    truth["gt_id"] = [int(r["gt_id"]) for r in truth_rows]
+    for field in ("x0", "y0", "x1", "y1"):
+        truth[field] = [float(r[field]) for r in truth_rows]
+    got = evldt.evaluate(segments, truth, 240, 180)
+    assert len(got["accuracy"]) == 2
+    for mine, theirs in zip(got["accuracy"], reference["accuracy"]):
+        for key in ("tolerance", "precision", "recall", "f"):
+            assert mine[key] == pytest.approx(theirs[key], abs=1e-12), key
+    assert 0.5 < got["accuracy"][0]["f"] < 1
+    assert got["ids"] == reference["lifetime"]["ids"]
+    assert got["lifetime_mean_ms"] == pytest.approx(reference["lifetime"]["mean_ms"])
+    assert got["coverage"] == pytest.approx(reference["tracking"]["coverage"])
+    assert got["idf1"] == pytest.approx(reference["tracking"]["idf1"])
+
+
+def test_simulated_ground_truth_equals_evldt_sim_csv(boxes):
+    simulated = evldt.simulate("boxes-6dof", duration_s=0.4)
+    expected = read_csv(boxes / "evt3" / "ground_truth.csv")
+    assert len(simulated.ground_truth) == len(expected) > 100
+    np.testing.assert_array_equal(simulated.ground_truth["t"], [int(r["t_us"]) for r in expected])
+    np.testing.assert_array_equal(simulated.ground_truth["gt_id"], [int(r["gt_id"]) for r in expected])
+    np.testing.assert_allclose(simulated.ground_truth["x0"], [float(r["x0"]) for r in expected], atol=1e-3)
+
+
+def test_a_corrupt_recording_raises_the_message_evldt_offline_prints(boxes, tmp_path):
+    data = bytearray(recording(boxes, "dat").read_bytes())
+    broken = tmp_path / "broken.dat"
+    broken.write_bytes(bytes(data[: len(data) // 2 + 3]))  # cut inside a record
+    offline = run(OFFLINE, broken, "-o", tmp_path / "s.csv", "-q", check=False)
+    assert offline.returncode == 2
+    with pytest.raises(evldt.FormatError) as error:
+        evldt.read(broken)
+    assert str(error.value) in offline.stderr
+    chunks = []
+    with pytest.raises(evldt.FormatError):
+        for chunk in evldt.read_chunks(broken, chunk_events=1000):
+            chunks.append(chunk)
+    assert sum(len(c) for c in chunks) > 1000  # the valid prefix came first
+
+
+def test_a_missing_file_raises_the_message_evldt_offline_prints(tmp_path):
+    missing = tmp_path / "nothing.raw"
+    offline = run(OFFLINE, "--format", "evt3", missing, check=False)
+    assert offline.returncode == 1
+    with pytest.raises(Exception) as error:
+        evldt.read(missing, format="evt3")
+    assert str(missing) in str(error.value)
+
+
+def test_bad_parameters_and_events_raise_value_errors():
+    with pytest.raises(ValueError, match="--fit-threshold"):
+        evldt.Pipeline(640, 480, fit_threshold=3)
+    with pytest.raises(ValueError, match="no_such_option|no-such-option"):
+        evldt.Pipeline(640, 480, no_such_option=1)
+    with pytest.raises(ValueError, match="sensor size"):
+        evldt.Pipeline(0, 480)
+    with pytest.raises(ValueError, match="scene"):
+        evldt.simulate("no-such-scene")
+    pipeline = evldt.Pipeline(640, 480)
+    with pytest.raises(ValueError, match="x values"):
+        pipeline.process(np.array([1, 2]), np.array([10, 70_000]), np.array([1, 1]), np.array([1, 1]))
+    with pytest.raises(ValueError, match="one length"):
+        pipeline.process(np.array([1, 2]), np.array([10]), np.array([1, 1]), np.array([1, 1]))
+    with pytest.raises(ValueError, match="structured"):
+        pipeline.process(np.zeros(3))
+    with pytest.raises(ValueError):
+        evldt.read(__file__, format="nonsense")
+
+
+def test_events_off_the_sensor_or_back_in_time_are_counted_drops():
+    pipeline = evldt.Pipeline(640, 480)
+    events = np.zeros(4, dtype=evldt.EVENT_DTYPE)
+    events["t"] = [100, 200, 50_000, 300]
+    events["x"] = [10, 640, 20, 30]
+    events["y"] = [10, 10, 479, 10]
+    pipeline.process(events)
+    counters = pipeline.counters()
+    assert counters["events_accepted"] == 2
+    assert counters["dropped_off_sensor"] == 1
+    assert counters["dropped_back_in_time"] == 1
+
+
+def test_message_types_round_trip():
+    segments = evldt.segment_list_t()
+    segment = evldt.line_segment_t()
+    segment.id = 7
+    segment.x0, segment.y0, segment.x1, segment.y1 = 1.5, 2.0, 30.0, 40.25
+    segments.segments = [segment]
+    segments.num_segments = 1
+    decoded = evldt.segment_list_t.decode(segments.encode())
+    assert decoded.num_segments == 1
+    assert decoded.segments[0].id == 7 and decoded.segments[0].y1 == 40.25
+
+
+@pytest.mark.skipif(not REAL.is_dir(), reason="../shared/real is absent: the real recordings are not here")
+def test_real_recordings_read_as_evldt_offline_reads_them(tmp_path):
+    checked = 0
+    for path in sorted(REAL.iterdir()):
+        if path.suffix not in (".raw", ".aedat4", ".h5", ".hdf5", ".dat") or path.stat().st_size > 200e6:
+            continue
+        summary = tmp_path / (path.name + ".json")
+        offline = run(OFFLINE, path, "-o", tmp_path / "s.csv", "-q", "--summary-json", summary, check=False)
+        if offline.returncode != 0:
+            continue
+        events = evldt.read(path).events
+        assert len(events) == json.loads(summary.read_text())["events_read"], path.name
+        checked += 1
+    assert checked > 0
