@@ -8,6 +8,7 @@ import csv
 import json
 import os
 import pathlib
+import struct
 import subprocess
 
 import numpy as np
@@ -220,3 +221,20 @@ def test_real_recordings_read_as_evldt_offline_reads_them(tmp_path):
         assert len(events) == json.loads(summary.read_text())["events_read"], path.name
         checked += 1
     assert checked > 0
+
+
+def test_lcm_log_reader_stops_with_a_format_error_on_a_cut_log(tmp_path):
+    message = evldt.segment_list_t()
+    message.source = "cam0"
+    data = message.encode()
+    record = struct.pack(">IqqII", 0xEDA1DA01, 0, 123, len("LINES_CAM0"), len(data)) + b"LINES_CAM0" + data
+    log = tmp_path / "cut.lcm"
+    log.write_bytes(record * 3 + record[:20])
+    got = []
+    with pytest.raises(evldt.FormatError, match="ends inside"):
+        for channel, utime, payload in evldt.read_lcm_log(log):
+            got.append(evldt.segment_list_t.decode(payload).source)
+    assert got == ["cam0"] * 3
+    log.write_bytes(record + b"garbage that is no record")
+    with pytest.raises(evldt.FormatError, match="no record starts here|ends inside"):
+        list(evldt.read_lcm_log(log))

@@ -62,6 +62,14 @@ check "viz drew frames into the mp4" test -s "$work/viz.mp4"
 check "viz wrote PNG snapshots" test "$(ls "$work/png" | wc -l)" -ge 2
 check "viz received the segment lists" grep -qP "received  $batches batches \(0 lost, 8 invalid\), [1-9][0-9]* segment lists \(0 invalid\), [1-9]" "$work/viz.out"
 
+# The Python example prints the recorded segment lists (where the Python module is built).
+if [[ -d $build/python/evldt ]]; then
+  PYTHONPATH=$build/python /usr/bin/python3 "$source_dir/libs/python/examples/print_log_segments.py" "$work/live.lcm" \
+    >"$work/python_log.out" 2>&1
+  tail -2 "$work/python_log.out"
+  check "the Python example reads the log's segment lists" grep -qP '^[1-9][0-9]* segment lists on LINES_CAM0$' "$work/python_log.out"
+fi
+
 # The recorded events are exactly the simulated ones: offline on the log = offline on the scene.
 "$offline" "$work/live.lcm" -o "$work/from_log.csv" -q >/dev/null 2>&1
 "$offline" "${scene[@]}" -o "$work/direct.csv" -q >/dev/null 2>&1

@@ -12,6 +12,7 @@ Parameters are the command-line flags of the tools, with underscores (block_size
 message. Long calls release the GIL.
 """
 
+import struct
 from collections import namedtuple
 
 import numpy as np
@@ -23,7 +24,7 @@ from .line_segment_t import line_segment_t
 from .segment_list_t import segment_list_t
 from .stats_t import stats_t
 
-__all__ = ["read", "read_chunks", "Recording", "Pipeline", "evaluate", "simulate", "Simulation", "EVENT_DTYPE",
+__all__ = ["read", "read_chunks", "read_lcm_log", "Recording", "Pipeline", "evaluate", "simulate", "Simulation", "EVENT_DTYPE",
            "SEGMENT_DTYPE", "GROUND_TRUTH_DTYPE", "STATUS_NAMES", "FormatError", "event_batch_t",
            "line_segment_t", "segment_list_t", "stats_t"]
 
@@ -144,3 +145,29 @@ def simulate(scene, gt_period_us=10_000, **options):
         raise ValueError("gt_period_us must be at least 1")
     events, truth, width, height = _evldt.simulate(["--scene", str(scene)] + _flags(options), int(gt_period_us))
     return Simulation(events, truth, width, height)
+
+
+_LCM_LOG_SYNC = 0xEDA1DA01
+_LCM_LOG_HEADER = struct.Struct(">IqqII")  # sync, event number, utime, channel length, data length
+
+
+def read_lcm_log(path):
+    """Yields (channel, utime, data) for each message of an lcm-log (the file lcm-logger writes),
+    without the lcm module; lcm.EventLog does the same where the lcm module is installed. A cut or
+    corrupt record raises FormatError after the records before it."""
+    with open(path, "rb") as f:
+        offset = 0
+        while True:
+            header = f.read(_LCM_LOG_HEADER.size)
+            if not header:
+                return
+            if len(header) < _LCM_LOG_HEADER.size:
+                raise FormatError(f"{path}: byte {offset}: the log ends inside a record header")
+            sync, _, utime, channel_length, data_length = _LCM_LOG_HEADER.unpack(header)
+            if sync != _LCM_LOG_SYNC:
+                raise FormatError(f"{path}: byte {offset}: no record starts here (sync word {sync:#010x})")
+            body = f.read(channel_length + data_length)
+            if len(body) < channel_length + data_length:
+                raise FormatError(f"{path}: byte {offset}: the log ends inside a record")
+            yield body[:channel_length].decode("utf-8", "replace"), utime, body[channel_length:]
+            offset += _LCM_LOG_HEADER.size + channel_length + data_length
