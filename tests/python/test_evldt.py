@@ -94,6 +94,8 @@ def test_pipeline_takes_separate_columns_and_is_deterministic(boxes):
     a = evldt.Pipeline(240, 180).process(events)
     b = evldt.Pipeline(240, 180).process(events["t"], events["x"].astype(np.int32), events["y"], events["p"])
     np.testing.assert_array_equal(a, b)
+    c = evldt.Pipeline(240, 180).process(events["t"], events["x"], events["y"], events["p"] > 0)  # on/off polarity
+    np.testing.assert_array_equal(a, c)
 
 
 def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):

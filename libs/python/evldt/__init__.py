@@ -82,6 +82,8 @@ def _column(values, dtype, name):
     array = np.asarray(values)
     if array.dtype == dtype:
         return array
+    if array.dtype == np.bool_:  # polarity as on/off
+        return array.astype(dtype)
     if not np.issubdtype(array.dtype, np.integer):
         raise ValueError(f"{name} must be integers, not {array.dtype}")
     info = np.iinfo(dtype)
