@@ -65,7 +65,11 @@ void LineDetector::detect_row(const ScarfLattice& lattice, LineMap& lines, int r
       lines.set_block_status(block, BlockStatus::NoDetect);  // suppression lasts one round
       continue;
     }
-    if (status != BlockStatus::NoDetect || lattice.active_count(block) < geometry_.min_points()) continue;
+    const int active = lattice.active_count(block);
+    if (status != BlockStatus::NoDetect || active < geometry_.min_points()) continue;
+    // f = r_o * r_e <= r_e <= active / N (r_o <= 1, inliers <= active): a block this sparse cannot
+    // clear f_th, so its fit is skipped; the same comparison in floats, so skipping is exact.
+    if (static_cast<float>(active) / capacity <= params_.fit_threshold) continue;
     const std::uint64_t version = lattice.version(block);
     if (failed_at_[block] == version) continue;
     failed_at_[block] = version;  // until it succeeds below
