@@ -10,6 +10,7 @@ import os
 import pathlib
 import struct
 import subprocess
+import threading
 
 import numpy as np
 import pytest
@@ -96,6 +97,26 @@ def test_pipeline_takes_separate_columns_and_is_deterministic(boxes):
     np.testing.assert_array_equal(a, b)
     c = evldt.Pipeline(240, 180).process(events["t"], events["x"], events["y"], events["p"] > 0)  # on/off polarity
     np.testing.assert_array_equal(a, c)
+
+
+def test_python_threads_may_share_a_pipeline(boxes):
+    events = evldt.read(recording(boxes, "evt3")).events
+    alone = evldt.Pipeline(240, 180).process(events)
+    shared = evldt.Pipeline(240, 180)
+    halves = np.array_split(np.arange(len(events)), 2)
+    results = {}
+
+    def feed(index):  # the halves must go in order: the second waits for the first's turn to end
+        results[index] = shared.process(events[halves[index]])
+
+    first = threading.Thread(target=feed, args=(0,))
+    first.start()
+    while first.is_alive():
+        shared.counters()  # reads while the other thread processes without the GIL
+        shared.segments()
+    first.join()
+    feed(1)
+    np.testing.assert_array_equal(np.concatenate([results[0], results[1]]), alone)
 
 
 def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):

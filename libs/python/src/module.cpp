@@ -12,6 +12,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -185,9 +186,11 @@ class Pipeline {
     const auto xs = x.unchecked<1>();
     const auto ys = y.unchecked<1>();
     const auto ps = p.unchecked<1>();
-    steps_.clear();
+    std::vector<SegmentRecord> completed;
     {
       py::gil_scoped_release unlocked;  // the arrays stay alive: the caller holds them
+      std::lock_guard lock(mutex_);
+      steps_.clear();
       for (py::ssize_t begin = 0; begin < n; begin += static_cast<py::ssize_t>(kStagingEvents)) {
         const py::ssize_t end = std::min(n, begin + static_cast<py::ssize_t>(kStagingEvents));
         staging_.clear();
@@ -195,18 +198,23 @@ class Pipeline {
         validator_->filter(staging_);
         pipeline_->process(staging_);
       }
+      completed.swap(steps_);
     }
-    return to_numpy(steps_);
+    return to_numpy(completed);
   }
 
   /// The live lines now, stamped with the newest event time seen.
   py::array_t<SegmentRecord> segments() const {
     std::vector<SegmentRecord> now;
-    append_lines(validator_->newest_time(), pipeline_->lines().lines(), now);
+    {
+      std::lock_guard lock(mutex_);
+      append_lines(validator_->newest_time(), pipeline_->lines().lines(), now);
+    }
     return to_numpy(now);
   }
 
   py::dict counters() const {
+    std::lock_guard lock(mutex_);
     py::dict out;
     const auto& c = pipeline_->counters();
     const auto& lines = pipeline_->lines();
@@ -226,6 +234,9 @@ class Pipeline {
   // Events are staged in slices this long: the pipeline takes its batch type, and a slice keeps
   // the staging memory small whatever the input's length.
   static constexpr std::size_t kStagingEvents = 1 << 16;
+  // Python threads may share a pipeline: process() runs without the GIL, so calls take turns here
+  // (taken only where the GIL is not needed before it is let go, so the two never wait on each other).
+  mutable std::mutex mutex_;
   std::optional<EventValidator> validator_;
   std::optional<DeterministicPipeline> pipeline_;
   EventBatch staging_;
