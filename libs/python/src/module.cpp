@@ -10,12 +10,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "evldt/app/pipeline_options.hpp"
@@ -115,15 +117,24 @@ class Reader {
     source_ = open_recording(path, parsed, channel, time_slack_us);
   }
 
-  /// The next `max_events` events (fewer only at the end); None at the end.
+  /// The next `max_events` events (fewer only at the end); None at the end. A corrupt recording
+  /// raises FormatError once every event before the fault has been returned.
   std::optional<py::array_t<EventRecord>> read(std::size_t max_events) {
+    if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
     {
       py::gil_scoped_release unlocked;
       chunk_.clear();
       while (chunk_.size() < max_events) {
         if (taken_ == pending_.size()) {
           taken_ = 0;
-          if (!source_->read(pending_)) break;
+          try {
+            if (!source_->read(pending_)) break;
+          } catch (const FormatError&) {
+            if (chunk_.empty()) throw;
+            failure_ = std::current_exception();  // after the events gathered so far
+            pending_.clear();
+            break;
+          }
         }
         const std::size_t n = std::min(max_events - chunk_.size(), pending_.size() - taken_);
         const auto from = static_cast<std::ptrdiff_t>(taken_), to = static_cast<std::ptrdiff_t>(taken_ + n);
@@ -151,6 +162,7 @@ class Reader {
   EventBatch pending_;     // the source's last batch
   std::size_t taken_ = 0;  // of pending_, already returned
   EventBatch chunk_;
+  std::exception_ptr failure_;  // raised by the next read()
 };
 
 /// The deterministic pipeline behind evldt-offline: validation, noise filters, storage, detection
