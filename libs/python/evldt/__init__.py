@@ -63,7 +63,8 @@ def read_chunks(path, chunk_events=1_000_000, format=None, channel="", time_slac
 
 def read(path, format=None, channel="", time_slack_us=1000):
     """A whole recording: Recording(events, width, height, format), where width and height are
-    None when the file does not say and format names the reader (as evldt-offline logs it)."""
+    None when the file does not say and format names the reader (as evldt-offline logs it). A
+    corrupt file raises FormatError (read_chunks yields the events before the fault first)."""
     reader = Reader(str(path), format or "", channel, time_slack_us)
     chunks = []
     while True:
