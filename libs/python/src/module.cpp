@@ -137,11 +137,7 @@ class Reader {
           }
         }
         const std::size_t n = std::min(max_events - chunk_.size(), pending_.size() - taken_);
-        const auto from = static_cast<std::ptrdiff_t>(taken_), to = static_cast<std::ptrdiff_t>(taken_ + n);
-        chunk_.t.insert(chunk_.t.end(), pending_.t.begin() + from, pending_.t.begin() + to);
-        chunk_.x.insert(chunk_.x.end(), pending_.x.begin() + from, pending_.x.begin() + to);
-        chunk_.y.insert(chunk_.y.end(), pending_.y.begin() + from, pending_.y.begin() + to);
-        chunk_.p.insert(chunk_.p.end(), pending_.p.begin() + from, pending_.p.begin() + to);
+        chunk_.append(pending_, taken_, taken_ + n);
         taken_ += n;
       }
     }

@@ -22,10 +22,7 @@ void EventBatcher::push(const EventBatch& events) {
     erase(buffer_.p);
     head_ = 0;
   }
-  buffer_.t.insert(buffer_.t.end(), events.t.begin(), events.t.end());
-  buffer_.x.insert(buffer_.x.end(), events.x.begin(), events.x.end());
-  buffer_.y.insert(buffer_.y.end(), events.y.begin(), events.y.end());
-  buffer_.p.insert(buffer_.p.end(), events.p.begin(), events.p.end());
+  buffer_.append(events, 0, events.size());
 }
 
 bool EventBatcher::pop(EventBatch& out, bool flush) {
@@ -36,11 +33,7 @@ bool EventBatcher::pop(EventBatch& out, bool flush) {
   while (end < buffer_.size() && end - head_ < max_events_ && buffer_.t[end] < end_t) ++end;
   const bool complete = end < buffer_.size() || end - head_ == max_events_;
   if (!complete && !flush) return false;
-  const auto first = static_cast<std::ptrdiff_t>(head_), last = static_cast<std::ptrdiff_t>(end);
-  out.t.assign(buffer_.t.begin() + first, buffer_.t.begin() + last);
-  out.x.assign(buffer_.x.begin() + first, buffer_.x.begin() + last);
-  out.y.assign(buffer_.y.begin() + first, buffer_.y.begin() + last);
-  out.p.assign(buffer_.p.begin() + first, buffer_.p.begin() + last);
+  out.append(buffer_, head_, end);  // out was cleared above
   head_ = end;
   return true;
 }

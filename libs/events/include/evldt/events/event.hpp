@@ -73,6 +73,14 @@ class EventBatch {
     y.push_back(py);
     p.push_back(polarity);
   }
+  /// Appends events [begin, end) of `from` (another batch).
+  void append(const EventBatch& from, std::size_t begin, std::size_t end) {
+    const auto first = static_cast<std::ptrdiff_t>(begin), last = static_cast<std::ptrdiff_t>(end);
+    t.insert(t.end(), from.t.begin() + first, from.t.begin() + last);
+    x.insert(x.end(), from.x.begin() + first, from.x.begin() + last);
+    y.insert(y.end(), from.y.begin() + first, from.y.begin() + last);
+    p.insert(p.end(), from.p.begin() + first, from.p.begin() + last);
+  }
   /// Keeps the first n events (or grows to n, the new ones zero).
   void truncate(std::size_t n) {
     t.resize(n);
