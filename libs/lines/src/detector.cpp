@@ -1,6 +1,7 @@
 #include "evldt/lines/detector.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "evldt/lines/line_fit.hpp"
@@ -29,11 +30,11 @@ int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp 
     versions_of_ = lattice.versions_of();
     std::fill(failed_at_.begin(), failed_at_.end(), kNeverFailed);
   }
-  next_row_.store(0, std::memory_order_relaxed);
+  std::atomic<int> next_row{0};  // the next row a worker claims
   auto detect_claimed = [&](int w) {
     Worker& worker = workers_[static_cast<std::size_t>(w)];
-    for (int row = next_row_.fetch_add(1, std::memory_order_relaxed); row < geometry_.blocks_y;
-         row = next_row_.fetch_add(1, std::memory_order_relaxed)) {
+    for (int row = next_row.fetch_add(1, std::memory_order_relaxed); row < geometry_.blocks_y;
+         row = next_row.fetch_add(1, std::memory_order_relaxed)) {
       detect_row(lattice, lines, row, worker);
     }
   };

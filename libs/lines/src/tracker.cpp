@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -97,11 +98,11 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
   // Every line's pass reads the lattice and writes only the line, so workers share the list freely.
   const std::size_t n = all.size();
   outcome_.resize(n);
-  next_line_.store(0, std::memory_order_relaxed);
+  std::atomic<std::size_t> next_line{0};  // the next line a worker claims
   auto track_claimed = [&](int w) {
     Worker& worker = workers_[static_cast<std::size_t>(w)];
     for (;;) {
-      const std::size_t begin = next_line_.fetch_add(kLinesPerClaim, std::memory_order_relaxed);
+      const std::size_t begin = next_line.fetch_add(kLinesPerClaim, std::memory_order_relaxed);
       if (begin >= n) return;
       for (std::size_t i = begin; i < std::min(n, begin + kLinesPerClaim); ++i) {
         ReleaseReason reason{};

@@ -3,7 +3,6 @@
 // fitting score clears the threshold. A block whose entries have not changed since it last failed
 // is skipped: the fit and the score depend on nothing else, so it would fail again.
 
-#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -48,7 +47,6 @@ class LineDetector {
   std::uint64_t versions_of_ = 0;         // the lattice whose block versions failed_at_ holds
   std::vector<std::uint64_t> failed_at_;  // per block: its version at its last failed attempt
   std::vector<Found> found_;              // per block
-  std::atomic<int> next_row_{0};          // the next row a worker claims
 };
 
 }  // namespace evldt

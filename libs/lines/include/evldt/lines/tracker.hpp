@@ -3,7 +3,6 @@
 // perturbations along the lattice lines its endpoints sit on, keeps the best-scoring one, and the
 // manager then settles ownership and suppression.
 
-#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -70,8 +69,7 @@ class LineTracker {
   /// Per line of the round: kKept, or the ReleaseReason it ends with. Lines are tracked first and
   /// released after, in the order one pass down the list would release them.
   std::vector<std::uint8_t> outcome_;
-  std::atomic<std::size_t> next_line_{0};  // the next line a worker claims
-  std::uint64_t versions_of_ = 0;          // ScarfLattice::versions_of() at the last round
+  std::uint64_t versions_of_ = 0;  // ScarfLattice::versions_of() at the last round
 };
 
 }  // namespace evldt
