@@ -1,7 +1,8 @@
 // evldt-bench: speed and memory of the core, and of receiving events off the wire, at every supported
-// sensor size, on one core (--threads: detection and tracking passes and the pipeline on a pool). For each size a built-in scene is simulated (the first --window-ms), and
-// each figure is the median of --repeats timed repeats, each repeat long enough (--min-time-ms) for
-// the clock not to matter.
+// sensor size, on one core (--threads N: the detection and tracking passes and the pipeline's rounds
+// on a pool of N). For each size a built-in scene is simulated (the first --window-ms), and each
+// figure is the median of --repeats timed repeats, each repeat long enough (--min-time-ms) for the
+// clock not to matter.
 // Every size runs in a child process of its own, so its peak RSS is its own.
 
 #include <CLI/CLI.hpp>
@@ -413,8 +414,9 @@ std::vector<std::filesystem::path> write_format_samples(const std::filesystem::p
 
 int main(int argc, char** argv) {
   CLI::App app{"evldt-bench: speed and memory of SCARF storage, a detection pass, a tracking pass, the lattice\n"
-               "snapshot and the whole deterministic pipeline at every sensor size, on one core. Prints a table\n"
-               "(medians over the repeats) and writes the figures as JSON."};
+               "snapshot and the whole deterministic pipeline at every sensor size, on one core (--threads: the\n"
+               "passes and rounds on more). Prints a table (medians over the repeats) and writes the figures as\n"
+               "JSON."};
   BenchSettings settings;
   std::vector<std::string> sizes;
   std::filesystem::path json_path;
