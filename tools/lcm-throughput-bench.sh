@@ -2,11 +2,13 @@
 # End-to-end LCM throughput on loopback: evldt-camera replays a simulated recording in a loop at
 # rising speed factors into evldt-lines for SECONDS each; reports per speed the event rate, batches
 # lost, CPU use of each process, bytes per event on the wire and the latency from batch publish to
-# the segment list that includes it (median / p99); then the highest rate held: zero lost batches and
-# p99 latency under --max-p99-ms (LCM queues up to 4096 batches, so a lines service that falls
-# behind shows as latency before it shows as loss).
+# the segment list that includes it (median / p99), the batches shed over evldt-lines' latency
+# budget, and the live F@1% (lcm-logger records the segment lists, evldt-eval scores them against
+# the scene's ground truth over the first pass of the recording, whose event time it spans); then
+# the highest rate held: zero lost batches and p99 latency under --max-p99-ms (LCM queues up to
+# 4096 batches, so a lines service that falls behind shows as latency before it shows as loss).
 # Usage: tools/lcm-throughput-bench.sh [--scene NAME] [--seconds S] [--publish-hz HZ] [--speeds "1 2 4"]
-#                                      [--max-p99-ms MS] [--json FILE] [--build DIR]
+#                                      [--max-p99-ms MS] [--json FILE] [--build DIR] [--no-f]
 #                                      [--lines-arg ARG]...  (passed to evldt-lines, e.g. --no-whole-lines)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -18,6 +20,7 @@ speeds="0.05 0.1 0.25 0.5 1 1.25"
 max_p99_ms=5
 json=
 lines_args=()
+score=true
 while (($#)); do
   case $1 in
     --scene) scene=$2; shift 2 ;;
@@ -28,14 +31,16 @@ while (($#)); do
     --json) json=$2; shift 2 ;;
     --build) build=$2; shift 2 ;;
     --lines-arg) lines_args+=("$2"); shift 2 ;;
-    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --no-f) score=false; shift ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "lcm-throughput-bench.sh: unknown argument $1 (see --help)" >&2; exit 1 ;;
   esac
 done
 camera=$build/services/evldt-camera/evldt-camera
 lines=$build/services/evldt-lines/evldt-lines
 sim=$build/tools/evldt-sim/evldt-sim
-for program in "$camera" "$lines" "$sim"; do
+eval_tool=$build/tools/evldt-eval/evldt-eval
+for program in "$camera" "$lines" "$sim" "$eval_tool"; do
   [[ -x $program ]] || { echo "lcm-throughput-bench.sh: $program missing: build first" >&2; exit 1; }
 done
 "$root/deploy/multicast-route.sh"
@@ -56,12 +61,12 @@ cpu_seconds() {  # user + system CPU seconds of a live process
   awk -v t="$ticks" '{ print ($14 + $15) / t }' "/proc/$1/stat"
 }
 field() {  # field FILE REGEX: the first number after REGEX
-  grep -oP "$2\s*\K[0-9.]+" "$1" | head -1
+  { grep -oP "$2\s*\K[0-9.]+" "$1" || true; } | head -1
 }
 
 printf 'scene %s, %s s per speed, segment lists at %s Hz, %s, evldt-lines %s\n' "$scene" "$seconds" "$publish_hz" "$url" \
   "${lines_args[*]:-(defaults)}"
-printf '%-7s %10s %14s %11s %11s %8s %10s %14s\n' speed "Mev/s" "batches lost" "camera CPU" "lines CPU" threads "B/event" "latency ms"
+printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %7s\n' speed "Mev/s" "batches lost" "shed (events %)" "camera CPU" "lines CPU" threads "B/event" "latency ms" "F@1%"
 rows=()
 best=0
 for speed in $speeds; do
@@ -69,6 +74,13 @@ for speed in $speeds; do
   lines_pid=$!
   pids+=("$lines_pid")
   for _ in $(seq 1200); do grep -q "evldt-lines ready:" "$work/lines.err" && break; sleep 0.05; done
+  if $score; then
+    rm -f "$work/lists.lcm"
+    nice -n -10 lcm-logger --lcm-url="${url}&recv_buf_size=8388608" -c 'LINES_CAM0' -q -f "$work/lists.lcm" >/dev/null 2>&1 &
+    logger_pid=$!
+    pids+=("$logger_pid")
+    sleep 0.3
+  fi
   "$camera" "$recording" --lcm-url "$url" --speed "$speed" --loop --quiet --log-level warn >"$work/camera.out" 2>"$work/camera.err" &
   camera_pid=$!
   pids+=("$camera_pid")
@@ -82,17 +94,31 @@ for speed in $speeds; do
   sleep 0.5  # the last lists
   kill -INT "$lines_pid"
   wait "$lines_pid" || true
+  f=n/a
+  if $score; then
+    kill -INT "$logger_pid"
+    wait "$logger_pid" || true
+    if "$eval_tool" --segments "$work/lists.lcm" --scene "$scene" --json "$work/eval.json" >/dev/null 2>&1; then
+      f=$(grep -oP '"f"\s*:\s*\K[0-9.]+' "$work/eval.json" | head -1 | xargs printf "%.3f")
+    fi
+  fi
   rate=$(field "$work/camera.out" 'wall \([0-9.]+x\),')
   bytes=$(field "$work/camera.out" 'MB,')
   received=$(field "$work/lines.out" 'batches')
   lost=$(field "$work/lines.out" 'received,')
+  batches_shed=$(field "$work/lines.out" 'shed')
+  events_shed=$(field "$work/lines.out" 'shed +[0-9]+ batches,')
+  events_in=$(field "$work/lines.out" 'events')
+  batches_shed=${batches_shed:-0}
+  events_shed=${events_shed:-0}
+  shed_pct=$(awk -v s="$events_shed" -v r="${events_in:-0}" 'BEGIN { printf "%.1f", (s + r > 0) ? 100 * s / (s + r) : 0 }')
   median=$(field "$work/lines.out" 'median')
   p99=$(field "$work/lines.out" 'p99')
   camera_pct=$(awk -v c="$camera_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
   lines_pct=$(awk -v c="$lines_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
   threads=$(field "$work/lines.err" 'rounds on')
-  printf '%-7s %10s %14s %11s %11s %8s %10s %14s\n' "$speed" "$rate" "$lost of $received" "$camera_pct" "$lines_pct" "$threads" "$bytes" "$median / $p99"
-  rows+=("{\"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"threads\": $threads, \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99}")
+  printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %7s\n' "$speed" "$rate" "$lost of $received" "$batches_shed ($shed_pct%)" "$camera_pct" "$lines_pct" "$threads" "$bytes" "$median / $p99" "$f"
+  rows+=("{\"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"batches_shed\": $batches_shed, \"events_shed\": $events_shed, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"threads\": $threads, \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99, \"live_f_1pct\": $( [[ $f == n/a ]] && echo null || echo "$f")}")
   if [[ $lost == 0 ]] && awk -v r="$rate" -v b="$best" -v p="$p99" -v m="$max_p99_ms" 'BEGIN { exit !(r > b && p < m) }'; then
     best=$rate
   fi

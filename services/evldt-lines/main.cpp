@@ -20,9 +20,16 @@ int main(int argc, char** argv) {
   PipelineOptions pipeline_options;
   LinesNodeOptions options;
   lcm_options.add_to(app);
-  app.add_option("--publish-hz", options.publish_hz, "Segment lists published per second")
+  app.add_option("--publish-hz", options.publish_hz,
+                 "Segment lists per second at most: one after each round that changed the lines, and an unchanged one "
+                 "once a second")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.1, 10000.0));
+  app.add_option("--max-latency-ms", options.max_latency_ms,
+                 "Latency budget: event batches that queued longer than this before they could be stored are shed "
+                 "whole, unstored (counted; their time still moves the rounds on). 0: never shed")
+      ->capture_default_str()
+      ->check(finite_number() & CLI::Range(0.0, 3600000.0));
   app.add_option("--stats-hz", options.stats_hz, "Statistics messages per second")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.01, 100.0));
@@ -30,7 +37,7 @@ int main(int argc, char** argv) {
                "Also publish whole lines (collinear touching segments joined, own ids) on WHOLE_LINES_<CAMERA>")
       ->capture_default_str();
   app.add_option("--whole-lines-hz", options.whole_lines_hz,
-                 "Whole-line lists per second: with every k-th segment list, k = publish-hz / this rounded, at least 1")
+                 "Whole-line lists per second at most (each goes with a segment list)")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.1, 10000.0));
   app.add_option("--log-period-s", options.log_period_s, "A status line in the log this often (0: never)")
@@ -53,6 +60,7 @@ int main(int argc, char** argv) {
     std::printf(
         "evldt-lines summary\n"
         "  batches   %llu received, %llu lost (sequence gaps), %llu late (%llu resyncs), %llu invalid messages, %llu camera restarts\n"
+        "  shed      %llu batches, %llu events: later than the %.0f ms latency budget, not stored\n"
         "  events    %llu received, %llu stored, %llu dropped as invalid (%llu off sensor, %llu back in time), %llu clock resets\n"
         "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
         "  loops     %llu detection rounds, %llu tracking rounds\n"
@@ -61,7 +69,9 @@ int main(int argc, char** argv) {
         static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),
         static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.sequence.resyncs),
         static_cast<unsigned long long>(t.receiver.invalid_messages),
-        static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.events_received),
+        static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.receiver.batches_shed),
+        static_cast<unsigned long long>(t.receiver.events_shed), options.max_latency_ms,
+        static_cast<unsigned long long>(t.events_received),
         static_cast<unsigned long long>(t.events_stored),
         static_cast<unsigned long long>(t.receiver.drops.total()), static_cast<unsigned long long>(t.receiver.drops.off_sensor),
         static_cast<unsigned long long>(t.receiver.drops.time_backwards),

@@ -1,7 +1,7 @@
 // Test helper: a subscriber on a far host, as a robot's consumer of evldt would be. Prints "ready"
 // once subscribed, then one line per message it hears, for the service tests to check and wait on:
 //   list RECV_WALL_US EPOCH SEQ T_US NEWEST_BATCH_SEQ NUM_SEGMENTS ID...
-//   stats RECV_WALL_US SERVICE EPOCH BATCHES_RECEIVED BATCHES_LOST INVALID_MESSAGES WORDS_SKIPPED
+//   stats RECV_WALL_US SERVICE EPOCH BATCHES_RECEIVED BATCHES_LOST INVALID_MESSAGES WORDS_SKIPPED BATCHES_SHED
 //   invalid RECV_WALL_US CHANNEL
 // Usage: lcm_lines_probe URL CAMERA SECONDS   (it stops after SECONDS, or at SIGTERM)
 
@@ -32,9 +32,9 @@ struct Probe {
   void on_stats(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
     evldt::stats_t stats;
     if (evldt::decode_message(payload_of(buffer), stats) != evldt::WireError::None) return invalid(channel);
-    std::printf("stats %" PRId64 " %s %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 "\n", evldt::wall_clock_us(),
-                stats.service.c_str(), stats.epoch, stats.batches_received, stats.batches_lost, stats.invalid_messages,
-                stats.words_skipped);
+    std::printf("stats %" PRId64 " %s %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 "\n",
+                evldt::wall_clock_us(), stats.service.c_str(), stats.epoch, stats.batches_received, stats.batches_lost,
+                stats.invalid_messages, stats.words_skipped, stats.batches_shed);
   }
   static void invalid(const std::string& channel) {
     std::printf("invalid %" PRId64 " %s\n", evldt::wall_clock_us(), channel.c_str());

@@ -12,6 +12,7 @@
 
 #include "evldt/transport/channels.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
+#include "evldt/transport/latency_budget.hpp"
 #include "evldt/transport/event_batcher.hpp"
 #include "evldt/transport/latency_tracker.hpp"
 #include "evldt/transport/lcm_log.hpp"
@@ -433,6 +434,67 @@ TEST(EventBatchReceiver, AdoptsSensorCountsLossAndRefusesForeignPayloads) {
   EXPECT_EQ(counts.sequence.received, 2u);
   EXPECT_EQ(counts.sequence.lost, 2u);
   EXPECT_EQ(counts.drops.off_sensor, 1u);
+}
+
+TEST(LatencyBudget, ShedsWhatQueuedPastTheBudgetWhateverTheSendersClock) {
+  for (const std::int64_t offset : {std::int64_t{0}, std::int64_t{5'000'000}, std::int64_t{-3'000'000}}) {
+    LatencyBudget budget(20);  // ms
+    // Delivered in 0.3-0.5 ms; the sender's clock is `offset` behind ours.
+    std::int64_t now = 10'000'000;
+    for (int i = 0; i < 100; ++i, now += 1000) EXPECT_FALSE(budget.late(now - offset - 300 - (i % 3) * 100, now)) << offset;
+    EXPECT_FALSE(budget.late(now - offset - 300 - 19'000, now));  // queued 19 ms: within
+    EXPECT_TRUE(budget.late(now - offset - 300 - 21'000, now));   // queued 21 ms: shed
+    EXPECT_NEAR(static_cast<double>(budget.last_queueing_us()), 21'000, 1);
+  }
+  LatencyBudget never(0);
+  EXPECT_FALSE(never.late(0, 10'000'000));
+  EXPECT_FALSE(never.late(1'000'000, 10'000'000));
+  EXPECT_THROW(LatencyBudget(-1), std::invalid_argument);
+}
+
+TEST(LatencyBudget, AClockStepIsForgottenWithinTwoWindows) {
+  LatencyBudget budget(20, /*window_us=*/1'000'000);
+  std::int64_t now = 0;
+  for (; now < 3'000'000; now += 1000) budget.late(now - 500, now);
+  // The sender's clock steps 50 ms back: every batch now looks 50 ms old, then the estimate follows.
+  bool shed_late = false;
+  for (; now < 6'000'000; now += 1000) {
+    const bool late = budget.late(now - 500 - 50'000, now);
+    if (now >= 5'000'000) shed_late = shed_late || late;
+  }
+  EXPECT_FALSE(shed_late);
+}
+
+TEST(EventBatchReceiver, ShedsLateBatchesUnreadButAccountsTheirSequence) {
+  EventBatchReceiver receiver(std::nullopt, 0);
+  LatencyBudget budget(20);
+  EventBatch out;
+  const std::int64_t now = 50'000'000;
+  const auto batch_at = [](std::int64_t seq, std::int64_t utime, Timestamp t0) {
+    event_batch_t msg = make_batch(make_events(10, t0), seq);
+    msg.utime = utime;
+    return encode(msg);
+  };
+  ASSERT_TRUE(receiver.receive(batch_at(0, now - 500, 0), out, budget, now));
+  EXPECT_FALSE(receiver.shed());
+  EXPECT_EQ(out.size(), 10u);
+  // Seq 1 queued 30 ms: shed, its events not decoded; its last event's time is kept.
+  ASSERT_TRUE(receiver.receive(batch_at(1, now - 30'500, 100), out, budget, now));
+  EXPECT_TRUE(receiver.shed());
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(receiver.shed_until_us(), 100 + 9 * 3);
+  ASSERT_TRUE(receiver.receive(batch_at(2, now - 400, 200), out, budget, now));
+  EXPECT_FALSE(receiver.shed());
+  EXPECT_EQ(out.size(), 10u);
+  // A shed batch is no loss, a late duplicate is not shed, junk is still refused.
+  EXPECT_FALSE(receiver.receive(batch_at(1, now - 30'500, 100), out, budget, now));
+  EXPECT_FALSE(receiver.receive(Bytes{1, 2, 3}, out, budget, now));
+  const ReceiverCounts counts = receiver.counts();
+  EXPECT_EQ(counts.sequence.received, 3u);
+  EXPECT_EQ(counts.sequence.lost, 0u);
+  EXPECT_EQ(counts.batches_shed, 1u);
+  EXPECT_EQ(counts.events_shed, 10u);
+  EXPECT_EQ(counts.invalid_messages, 1u);
 }
 
 TEST(EventBatchReceiver, RefusesSensorSizesBeyondTheLimitOrThatTheSubscriberCannotUse) {

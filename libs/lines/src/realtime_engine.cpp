@@ -4,11 +4,17 @@
 #include <chrono>
 #include <limits>
 
+#include "evldt/lines/thread_name.hpp"
+
 namespace evldt {
 
 namespace {
 // Longest run of events stored under one lock hold, so the loops' snapshots never wait long.
 constexpr std::size_t kInsertChunk = 8192;
+// Input that stops for this long (wall time) is a pause: the rounds then run on what is new
+// without waiting for a period of event time. Longer than a live camera's or a slow replay's gap
+// between batches, short enough that the last events of a stream are answered promptly.
+constexpr auto kInputPause = std::chrono::milliseconds(10);
 }  // namespace
 
 RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
@@ -31,11 +37,11 @@ void RealtimeEngine::start() {
     stopping_ = false;
   }
   detect_thread_ = std::thread([this] {
-    loop(detect_view_, detect_wake_at_us_, detect_rounds_, config_.schedule.detect_period_us,
+    loop("evldt-detect", detect_view_, detect_wake_at_us_, detect_rounds_, config_.schedule.detect_period_us,
          [this](const ScarfLattice& view, Timestamp now) { detector_.detect(view, lines_, now); });
   });
   track_thread_ = std::thread([this] {
-    loop(track_view_, track_wake_at_us_, track_rounds_, config_.schedule.track_period_us,
+    loop("evldt-track", track_view_, track_wake_at_us_, track_rounds_, config_.schedule.track_period_us,
          [this](const ScarfLattice& view, Timestamp now) { tracker_.track(view, lines_, now); });
   });
 }
@@ -81,31 +87,40 @@ void RealtimeEngine::process(const EventBatch& input) {
   } while (begin < n);
 }
 
+void RealtimeEngine::shed(Timestamp until_us) {
+  // No round is woken: nothing new was stored, and the next stored batch brings the time with it.
+  std::lock_guard lock(lattice_mutex_);
+  latest_event_us_ = std::max(latest_event_us_, until_us);
+}
+
 void RealtimeEngine::note_input(const EventBatch& input) {
   events_received_ += input.size();
   latest_event_us_ = std::max(latest_event_us_, input.t.back());
 }
 
 template <typename Round>
-void RealtimeEngine::loop(ScarfLattice& view, Timestamp& wake_at_us, std::atomic<std::uint64_t>& rounds,
-                          Timestamp period_us, Round round) {
+void RealtimeEngine::loop(const char* thread_name, ScarfLattice& view, Timestamp& wake_at_us,
+                          std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round) {
+  name_this_thread(thread_name);
   std::uint64_t seen = 0;
   Timestamp next_due = std::numeric_limits<Timestamp>::min();
-  const auto wall_period = std::chrono::microseconds(period_us);
   for (;;) {
     Timestamp now = 0;
     {
       std::unique_lock lock(lattice_mutex_);
-      // A round is due once a period of event time has come in since the last one (the
-      // deterministic schedule; more rounds would repeat work the storage thread needs the CPU
-      // for). Without new input, a round would repeat the last one.
+      // A round is due once a period of event time has come in since the last one: the rounds
+      // follow the events (the deterministic schedule), not the wall clock, so a slow stream costs
+      // rounds in proportion to its event time. Only when the input pauses (a sparse or ending
+      // stream) does a round run early, on whatever is new, so the last events never wait.
       const auto due = [&] { return stopping_ || (events_received_ != seen && latest_event_us_ >= next_due); };
       wake_at_us = next_due;
-      if (!lattice_changed_.wait_for(lock, wall_period, due)) {
-        // A period of wall time without a period of event time (a sparse or ending stream): run
-        // on whatever is new, so the last events are never left waiting.
-        wake_at_us = std::numeric_limits<Timestamp>::min();
-        lattice_changed_.wait(lock, [&] { return stopping_ || events_received_ != seen; });
+      while (!due()) {
+        if (events_received_ == seen) {
+          lattice_changed_.wait(lock, [&] { return stopping_ || events_received_ != seen; });  // idle: no CPU
+          continue;
+        }
+        const std::uint64_t received_before = events_received_;
+        if (!lattice_changed_.wait_for(lock, kInputPause, due) && events_received_ == received_before) break;
       }
       wake_at_us = std::numeric_limits<Timestamp>::max();  // busy with a round: nothing to wake
       if (stopping_) return;
@@ -118,15 +133,22 @@ void RealtimeEngine::loop(ScarfLattice& view, Timestamp& wake_at_us, std::atomic
       std::lock_guard lock(lines_mutex_);
       round(view, now);
       lines_time_us_ = std::max(lines_time_us_, now);
+      lines_version_.fetch_add(1, std::memory_order_release);
     }
+    round_done_.notify_all();
     rounds.fetch_add(1, std::memory_order_relaxed);
   }
 }
 
-Timestamp RealtimeEngine::snapshot(std::vector<TrackedLine>& out) const {
+void RealtimeEngine::wait_for_round(std::uint64_t version, std::chrono::steady_clock::time_point deadline) const {
+  std::unique_lock lock(lines_mutex_);
+  round_done_.wait_until(lock, deadline, [&] { return lines_version_.load(std::memory_order_relaxed) != version; });
+}
+
+RealtimeEngine::LinesState RealtimeEngine::snapshot(std::vector<TrackedLine>& out) const {
   std::lock_guard lock(lines_mutex_);
   out.assign(lines_.lines().begin(), lines_.lines().end());
-  return lines_time_us_;
+  return {lines_time_us_, lines_version_.load(std::memory_order_relaxed)};
 }
 
 std::vector<std::uint32_t> RealtimeEngine::masked_pixels() const {

@@ -1,11 +1,13 @@
 #include "evldt/nodes/lines_node.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
 
+#include "evldt/lines/thread_name.hpp"
 #include "evldt/transport/channels.hpp"
 
 namespace evldt {
@@ -31,6 +33,7 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
                 [this](SensorSize size) {
                   return LatticeGeometry::fits(size, options_.configure(size).lattice.block_size);
                 }),
+      budget_(options_.max_latency_ms),
       next_line_id_(static_cast<std::uint64_t>(epoch_us)),
       next_whole_id_(static_cast<std::uint64_t>(epoch_us)) {
   batch_.reserve(1 << 16);
@@ -38,7 +41,6 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
       !(options_.whole_lines_hz > 0 && options_.whole_lines_hz <= 10000)) {
     throw std::invalid_argument("publish and whole-line rates must be in (0, 10000] Hz and the stats rate in (0, 100] Hz");
   }
-  lists_per_whole_list_ = std::max<std::int64_t>(1, std::llround(options_.publish_hz / options_.whole_lines_hz));
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
   subscription_ = lcm_.subscribe(events_channel(options_.camera), &LinesNode::on_events, this);
   if (!subscription_) throw std::runtime_error("cannot subscribe to " + events_channel(options_.camera));
@@ -59,9 +61,18 @@ std::shared_ptr<RealtimeEngine> LinesNode::engine() const {
 
 void LinesNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
   const std::span<const std::uint8_t> payload(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size);
-  const bool accepted = receiver_.receive(payload, batch_);
+  const bool accepted = receiver_.receive(payload, batch_, budget_, wall_clock_us());
   if (accepted && (!engine_ || receiver_.restarted())) start_engine();
-  if (accepted && !batch_.empty()) engine_->process(batch_);
+  if (accepted && receiver_.shed()) {
+    engine_->shed(receiver_.shed_until_us());
+    if (std::has_single_bit(receiver_.counts().batches_shed)) {
+      spdlog::warn("shed {} batch(es) that came later than the {} ms latency budget (latest queued {:.1f} ms)",
+                   receiver_.counts().batches_shed, options_.max_latency_ms,
+                   static_cast<double>(budget_.last_queueing_us()) * 1e-3);
+    }
+  } else if (accepted && !batch_.empty()) {
+    engine_->process(batch_);
+  }
   std::lock_guard lock(mutex_);
   receiver_counts_ = receiver_.counts();
   if (accepted && !batch_.empty()) {
@@ -112,14 +123,23 @@ void LinesNode::run(const std::atomic<bool>& stop) {
 }
 
 void LinesNode::publish_loop(const std::atomic<bool>& stop) {
+  name_this_thread("evldt-publish");
+  // A list goes out once a round has changed the lines, at most one per publish period; an
+  // unchanged one again after a second (a heartbeat, so a subscriber sees the service live).
+  constexpr auto kHeartbeat = std::chrono::seconds(1);
+  constexpr auto kLongestWait = std::chrono::milliseconds(100);  // the stop flag is checked this often
   const auto publish_period = period_of(options_.publish_hz);
   const auto stats_period = period_of(options_.stats_hz);
   auto next_publish = Clock::now();
+  auto last_list = next_publish;
   auto last_stats = next_publish;
   auto last_log = next_publish;
   while (!stop.load()) {
-    publish_segments();
-    const auto now = Clock::now();
+    auto now = Clock::now();
+    if (now >= next_publish && publish_segments(now - last_list >= kHeartbeat)) {
+      last_list = now;
+      next_publish = now + publish_period;
+    }
     if (now - last_stats >= stats_period) {
       publish_stats(std::chrono::duration<double>(now - last_stats).count());
       last_stats = now;
@@ -127,22 +147,33 @@ void LinesNode::publish_loop(const std::atomic<bool>& stop) {
     if (options_.log_period_s > 0 && now - last_log >= std::chrono::duration<double>(options_.log_period_s)) {
       last_log = now;
       const LinesNodeTotals t = totals();
-      spdlog::info("{} events stored, {} batches ({} lost, {} invalid messages), {} lines created, {} lists published, "
-                   "latency {:.1f} / {:.1f} ms (median / p99 of the last statistics period)",
-                   t.events_stored, t.receiver.sequence.received, t.receiver.sequence.lost,
+      spdlog::info("{} events stored, {} batches ({} lost, {} shed over the latency budget, {} invalid messages), "
+                   "{} lines created, {} lists published, latency {:.1f} / {:.1f} ms (median / p99 of the last "
+                   "statistics period)",
+                   t.events_stored, t.receiver.sequence.received, t.receiver.sequence.lost, t.receiver.batches_shed,
                    t.receiver.invalid_messages, t.lines_created, t.lists_published, last_latency_.median_ms,
                    last_latency_.p99_ms);
     }
-    next_publish += publish_period;
-    if (next_publish < now) next_publish = now;  // fell behind: do not burst to catch up
-    std::this_thread::sleep_until(next_publish);
+    now = Clock::now();
+    const auto wake = std::min({last_stats + stats_period, last_list + kHeartbeat, now + kLongestWait});
+    const auto engine = this->engine();
+    if (now < next_publish || !engine) {
+      std::this_thread::sleep_until(std::min(next_publish, wake));
+    } else {
+      engine->wait_for_round(published_engine_ == engine ? published_version_ : 0, wake);
+    }
   }
 }
 
-void LinesNode::publish_segments() {
+bool LinesNode::publish_segments(bool heartbeat) {
   const auto engine = this->engine();
-  if (!engine) return;  // nothing received yet
-  const Timestamp lattice_us = engine->snapshot(lines_);
+  if (!engine) return false;  // nothing received yet
+  const bool same_engine = engine == published_engine_;
+  if (same_engine && !heartbeat && engine->lines_version() == published_version_) return false;  // no round since the last list
+  const RealtimeEngine::LinesState state = engine->snapshot(lines_);
+  published_engine_ = engine;
+  published_version_ = state.version;
+  const Timestamp lattice_us = state.lattice_us;
   fill_segment_list(lines_, list_msg_);
   const std::int64_t now = wall_clock_us();
   LatencyTracker::Included included;
@@ -161,7 +192,20 @@ void LinesNode::publish_segments() {
   list_msg_.newest_batch_seq = included.seq;
   list_msg_.newest_batch_utime = included.utime;
   if (lcm_.publish(lines_channel_, &list_msg_) == 0) lists_published_.fetch_add(1, std::memory_order_relaxed);
-  if (options_.whole_lines && list_msg_.seq % lists_per_whole_list_ == 0) publish_whole_lines(engine, lattice_us);
+  // Whole lines at most at their rate in wall time (up to a publish period early, so at equal
+  // rates they go with every segment list) and in event time (up to a tracking period early): a
+  // stream replayed slowly costs whole-line steps in proportion to its event time, as it does rounds.
+  const auto now_steady = Clock::now();
+  const Timestamp event_period_us =
+      static_cast<Timestamp>(1e6 / options_.whole_lines_hz) - engine->config().schedule.track_period_us;
+  const bool whole_due = now_steady >= next_whole_list_ &&
+                         (!joiner_ || engine != joined_engine_ || lattice_us < joiner_->last_time() ||
+                          lattice_us - joiner_->last_time() >= event_period_us);
+  if (options_.whole_lines && whole_due) {
+    next_whole_list_ = now_steady + period_of(options_.whole_lines_hz) - period_of(options_.publish_hz);
+    publish_whole_lines(engine, lattice_us);
+  }
+  return true;
 }
 
 void LinesNode::publish_whole_lines(const std::shared_ptr<RealtimeEngine>& engine, Timestamp lattice_us) {
@@ -215,6 +259,9 @@ void LinesNode::publish_stats(double period_s) {
   msg.latency_samples = static_cast<std::int32_t>(latency.samples);
   msg.latency_median_ms = static_cast<float>(latency.median_ms);
   msg.latency_p99_ms = static_cast<float>(latency.p99_ms);
+  msg.latency_budget_ms = static_cast<float>(options_.max_latency_ms);
+  msg.batches_shed = static_cast<std::int64_t>(now.receiver.batches_shed);
+  msg.events_shed = static_cast<std::int64_t>(now.receiver.events_shed);
   msg.filtered_hot_pixel = static_cast<std::int64_t>(now.filtered.hot_pixel);
   msg.filtered_background_activity = static_cast<std::int64_t>(now.filtered.background_activity);
   msg.filtered_refractory = static_cast<std::int64_t>(now.filtered.refractory);

@@ -106,9 +106,9 @@ void VizNode::render(cv::Mat& canvas) {
   if (stats_) {
     draw_masked_pixels(sensor, stats_->masked_pixels, options_.render.scale, canvas);
     put_line(canvas,
-             fmt::format("detect {:.0f} Hz  track {:.0f} Hz  latency {:.1f}/{:.1f} ms  lost {}  hot pixels {}", stats_->detect_hz,
-                         stats_->track_hz, stats_->latency_median_ms, stats_->latency_p99_ms, stats_->batches_lost,
-                         stats_->num_masked_pixels),
+             fmt::format("detect {:.0f} Hz  track {:.0f} Hz  latency {:.1f}/{:.1f} ms  lost {}  shed {}  hot pixels {}",
+                         stats_->detect_hz, stats_->track_hz, stats_->latency_median_ms, stats_->latency_p99_ms,
+                         stats_->batches_lost, stats_->batches_shed, stats_->num_masked_pixels),
              1);
   } else {
     put_line(canvas, "no statistics from evldt-lines yet", 1);

@@ -17,32 +17,56 @@ void EventBatchReceiver::refuse(const char* why) {
 }
 
 bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBatch& out) {
+  shed_ = false;
   if (const WireError error = decode_event_batch(payload, message_, out); error != WireError::None) {
     out.clear();
     refuse(error == WireError::WrongType ? "not an evldt event_batch_t" : "malformed event_batch_t");
     return false;
   }
+  if (!admit()) {
+    out.clear();
+    return false;
+  }
+  const std::uint64_t clock_resets_before = validator_->drops().clock_resets;
+  validator_->filter(out);
+  // A clock that went back is a restart for the subscriber as well: its state belongs to the old clock.
+  if (validator_->drops().clock_resets != clock_resets_before) restarted_ = true;
+  return true;
+}
+
+bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBatch& out, LatencyBudget& budget,
+                                 std::int64_t now_utime) {
+  Timestamp last_event_us = 0;
+  if (decode_event_batch_header(payload, message_, last_event_us) != WireError::None) {
+    return receive(payload, out);  // refused there, with its reason
+  }
+  if (!budget.late(message_.utime, now_utime)) return receive(payload, out);
+  out.clear();
+  shed_ = false;
+  if (!admit()) return false;
+  shed_ = true;
+  shed_until_us_ = last_event_us;
+  ++batches_shed_;
+  events_shed_ += static_cast<std::uint64_t>(message_.num_events);
+  return true;
+}
+
+bool EventBatchReceiver::admit() {
   const SensorSize size{message_.width, message_.height};
   if (!size.valid()) {
-    out.clear();
     refuse("invalid sensor size");
     return false;
   }
   if (sensor_ && size != *sensor_) {
-    out.clear();
     refuse("sensor size differs from the stream's");
     return false;
   }
   if (!sensor_ && usable_ && !usable_(size)) {
-    out.clear();
     refuse("sensor size this subscriber cannot work with");
     return false;
   }
   const std::uint64_t restarts_before = sequence_.counts().restarts;
-  if (!sequence_.observe(message_.epoch, message_.seq)) {
-    out.clear();
-    return false;
-  }
+  if (!sequence_.observe(message_.epoch, message_.seq)) return false;
   restarted_ = sequence_.counts().restarts != restarts_before;
   if (!sensor_) sensor_ = size;
   if (!validator_ || restarted_) {
@@ -54,10 +78,6 @@ bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBat
     }
     validator_.emplace(*sensor_, slack_);
   }
-  const std::uint64_t clock_resets_before = validator_->drops().clock_resets;
-  validator_->filter(out);
-  // A clock that went back is a restart for the subscriber as well: its state belongs to the old clock.
-  if (validator_->drops().clock_resets != clock_resets_before) restarted_ = true;
   return true;
 }
 
@@ -66,6 +86,8 @@ ReceiverCounts EventBatchReceiver::counts() const {
   counts.invalid_messages = invalid_;
   counts.sequence = sequence_.counts();
   counts.drops = drops_before_restart_;
+  counts.batches_shed = batches_shed_;
+  counts.events_shed = events_shed_;
   if (validator_) {
     counts.drops.off_sensor += validator_->drops().off_sensor;
     counts.drops.time_backwards += validator_->drops().time_backwards;

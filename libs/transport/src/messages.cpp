@@ -69,7 +69,7 @@ class WireWalker {
 
 // Encoded sizes of the fixed parts (see the .lcm files).
 constexpr std::size_t kSegmentWireBytes = 8 + 5 * 4 + 1 + 4 + 8 + 8;
-constexpr std::size_t kStatsMiddleBytes = 8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 2 * 8;  // period_s .. trigger_events
+constexpr std::size_t kStatsMiddleBytes = 8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 4 + 2 * 8 + 2 * 8;  // period_s .. trigger_events
 
 template <typename Message>
 WireError check_hash(WireWalker& walker) {
@@ -187,7 +187,8 @@ void encode_event_batch(const event_batch_t& header, const EventBatch& events, s
 
 namespace {
 
-WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events) {
+// Checks a whole event batch's framing and reads its scalar fields; `events` points at its columns.
+WireError decode_event_batch_header_at(std::span<const std::uint8_t> bytes, event_batch_t& header, const std::uint8_t*& events) {
   if (bytes.size() > kMaxMessageBytes) return WireError::Malformed;
   WireWalker walker(bytes);
   if (const auto hash = check_hash<event_batch_t>(walker); hash != WireError::None) return hash;
@@ -204,12 +205,18 @@ WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_bat
   header.x.clear();
   header.y.clear();
   header.polarity.clear();
-  const auto n = static_cast<std::size_t>(count);
+  events = walker.here();
+  return WireError::None;
+}
+
+WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events) {
+  const std::uint8_t* dt = nullptr;
+  if (const WireError error = decode_event_batch_header_at(bytes, header, dt); error != WireError::None) return error;
+  const auto n = static_cast<std::size_t>(header.num_events);
   events.t.resize(n);
   events.x.resize(n);
   events.y.resize(n);
   events.p.resize(n);
-  const std::uint8_t* dt = walker.here();
   const std::uint8_t* xs = dt + 4 * n;
   const std::uint8_t* ys = xs + 2 * n;
   const std::uint8_t* polarity = ys + 2 * n;
@@ -223,6 +230,16 @@ WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_bat
 }
 
 }  // namespace
+
+WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_batch_t& header, Timestamp& last_event_us) {
+  const std::uint8_t* dt = nullptr;
+  if (const WireError error = decode_event_batch_header_at(bytes, header, dt); error != WireError::None) return error;
+  last_event_us = header.t_base_us;
+  if (header.num_events > 0) {
+    last_event_us += static_cast<std::int32_t>(get_be32(dt + 4 * (static_cast<std::size_t>(header.num_events) - 1)));
+  }
+  return WireError::None;
+}
 
 WireError decode_event_batch(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events) {
   // `events` is resized, not cleared first: the columns keep their size from the last batch, so

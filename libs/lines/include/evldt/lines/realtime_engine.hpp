@@ -1,11 +1,14 @@
 #pragma once
-// The real-time engine (DESIGN 6): the caller's thread filters and stores events as they arrive while detection
-// and tracking loop on their own threads, each starting a round once a period of event time has
-// been stored since its last (or a period of wall time has passed with anything new). Each loop
-// works on its own copy of the lattice, updated under a short lock, so storage never waits for a
-// whole pass; the line state is shared by the two loops under a second lock.
+// The real-time engine (DESIGN 6, 9): the caller's thread filters and stores events as they arrive
+// while detection and tracking loop on their own threads, each starting a round once a period of
+// event time has been stored since its last (or, when the input pauses, on whatever is new). So
+// the rounds follow the events: a stream replayed at a tenth of real time costs a tenth of the
+// rounds. Each loop works on its own copy of the lattice, updated under a short lock, so storage
+// never waits for a whole pass, and a round always starts from the newest state: rounds never
+// queue. The line state is shared by the two loops under a second lock.
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -38,10 +41,19 @@ class RealtimeEngine {
 
   /// Filters and stores on-sensor, time-ordered events (from one producer thread).
   void process(const EventBatch& batch);
+  /// Events up to `until_us` were shed unstored (over the latency budget): event time still moves on.
+  void shed(Timestamp until_us);
 
-  /// Copies the live lines into `out` (reusing its capacity) and returns the event time of the lattice
-  /// state they were last tracked or detected on.
-  Timestamp snapshot(std::vector<TrackedLine>& out) const;
+  struct LinesState {
+    Timestamp lattice_us = 0;   ///< event time of the lattice state the lines were last tracked or detected on
+    std::uint64_t version = 0;  ///< rounds finished so far: equal values, equal lines
+  };
+  /// Copies the live lines into `out` (reusing its capacity).
+  LinesState snapshot(std::vector<TrackedLine>& out) const;
+  /// The version snapshot() would return now, without copying (a publisher skips an unchanged state).
+  [[nodiscard]] std::uint64_t lines_version() const { return lines_version_.load(std::memory_order_acquire); }
+  /// Waits, without using the CPU, until a round has finished past `version`, or until `deadline`.
+  void wait_for_round(std::uint64_t version, std::chrono::steady_clock::time_point deadline) const;
   [[nodiscard]] EngineCounters counters() const;
   /// The pixels the hot-pixel filter masks now (y * width + x).
   [[nodiscard]] std::vector<std::uint32_t> masked_pixels() const;
@@ -53,7 +65,7 @@ class RealtimeEngine {
  private:
   void note_input(const EventBatch& input);  // under lattice_mutex_
   template <typename Round>
-  void loop(ScarfLattice& view, Timestamp& wake_at_us, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
+  void loop(const char* thread_name, ScarfLattice& view, Timestamp& wake_at_us, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
             Round round);
 
   PipelineConfig config_;
@@ -78,6 +90,8 @@ class RealtimeEngine {
   LineDetector detector_;                     // used only under lines_mutex_
   LineTracker tracker_;                       // used only under lines_mutex_
   Timestamp lines_time_us_ = 0;               // guarded by lines_mutex_
+  std::atomic<std::uint64_t> lines_version_{0};  // written under lines_mutex_
+  mutable std::condition_variable round_done_;   // with lines_mutex_
 
   std::atomic<std::uint64_t> detect_rounds_{0}, track_rounds_{0};
   std::thread detect_thread_, track_thread_;

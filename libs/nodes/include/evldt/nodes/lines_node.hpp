@@ -1,9 +1,12 @@
 #pragma once
 // The evldt-lines service without its command line: subscribes to one camera's event batches,
 // stores them in the real-time engine on the receive thread (which never waits for a detection or
-// tracking pass), and publishes the live segments at a set rate and its statistics once a second.
+// tracking pass), sheds the batches that come later than its latency budget, and publishes the
+// live segments whenever a round changed them (at most at a set rate, at least once a second) and
+// its statistics once a second.
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
@@ -19,23 +22,29 @@
 
 namespace evldt {
 
+/// The default latency budget: well above the queueing of a service that keeps up (a few ms), well
+/// below answers too old to steer by (README, real time under load).
+inline constexpr double kDefaultMaxLatencyMs = 20;
+
 struct LinesNodeOptions {
   std::string camera = "cam0";
   std::optional<SensorSize> sensor;  ///< unset: adopt the first valid batch's
   std::function<PipelineConfig(SensorSize)> configure = default_config_for;
   Timestamp time_slack_us = 1000;
-  double publish_hz = 100;
+  double publish_hz = 100;  ///< at most this many segment lists a second: one after each round, when rounds are faster
+  /// Batches that queued longer than this before they could be stored are shed whole (0: never).
+  double max_latency_ms = kDefaultMaxLatencyMs;
   double stats_hz = 1;
   double log_period_s = 10;  ///< a status line in the log this often (0: never)
   bool whole_lines = true;   ///< also publish whole lines on WHOLE_LINES_<CAMERA>
-  /// Whole-line lists per second: with every k-th segment list, k = publish_hz / whole_lines_hz
-  /// rounded, at least 1 (a whole-line step costs 1.8 ms at HD; lines change little in 1 ms).
+  /// Whole-line lists per second at most: with a segment list, once 1 / whole_lines_hz has passed since
+  /// the last (a whole-line step costs 1.8 ms at HD; lines change little in 1 ms).
   double whole_lines_hz = 100;
 };
 
 /// Totals since start (what the stats message and the exit summary report).
 struct LinesNodeTotals {
-  ReceiverCounts receiver;
+  ReceiverCounts receiver;           ///< batches received, lost, invalid and shed
   std::uint64_t events_received = 0;  ///< valid events handed to the engine
   FilterCounts filtered;              ///< what the noise filters dropped of them
   std::uint64_t events_stored = 0;
@@ -64,7 +73,9 @@ class LinesNode {
   void on_events(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void start_engine();
   void publish_loop(const std::atomic<bool>& stop);
-  void publish_segments();
+  /// Publishes the lines if a round changed them since the last list, or if `heartbeat` is set;
+  /// true if it sent a list.
+  bool publish_segments(bool heartbeat);
   void publish_whole_lines(const std::shared_ptr<RealtimeEngine>& engine, Timestamp lattice_us);
   void publish_stats(double period_s);
   [[nodiscard]] std::shared_ptr<RealtimeEngine> engine() const;
@@ -78,6 +89,7 @@ class LinesNode {
 
   // Receive thread only.
   EventBatchReceiver receiver_;
+  LatencyBudget budget_;
   EventBatch batch_;
 
   mutable std::mutex mutex_;  // guards the members below (the receive thread alone writes them)
@@ -92,6 +104,8 @@ class LinesNode {
   std::vector<TrackedLine> lines_;
   segment_list_t list_msg_;
   std::int64_t list_seq_ = 0;
+  std::uint64_t published_version_ = 0;  ///< the engine's lines version in the last list
+  std::shared_ptr<const RealtimeEngine> published_engine_;
   std::atomic<std::uint64_t> lists_published_{0};
   std::optional<WholeLineTracker> joiner_;  ///< for the engine below (held, so a new one is told apart)
   std::shared_ptr<const RealtimeEngine> joined_engine_;
@@ -99,7 +113,7 @@ class LinesNode {
   std::vector<TrackedLine> whole_;
   segment_list_t whole_msg_;
   std::int64_t whole_seq_ = 0;
-  std::int64_t lists_per_whole_list_ = 1;
+  std::chrono::steady_clock::time_point next_whole_list_{};
   LinesNodeTotals last_stats_;
   LatencySummary last_latency_;  ///< of the last statistics message, for the log line
 };

@@ -9,6 +9,7 @@
 #include <span>
 
 #include "evldt/events/event_validator.hpp"
+#include "evldt/transport/latency_budget.hpp"
 #include "evldt/transport/messages.hpp"
 #include "evldt/transport/sequence_tracker.hpp"
 
@@ -18,6 +19,8 @@ struct ReceiverCounts {
   std::uint64_t invalid_messages = 0;  ///< undecodable (time base out of range included), foreign type, bad sensor size
   SequenceCounts sequence;
   DropCounts drops;                    ///< events refused by the validator (before a restart included)
+  std::uint64_t batches_shed = 0;      ///< valid, current batches that came later than the latency budget
+  std::uint64_t events_shed = 0;       ///< their events, neither decoded nor validated
 };
 
 class EventBatchReceiver {
@@ -33,6 +36,10 @@ class EventBatchReceiver {
   /// events and returns true (`out` may then be empty). A batch of a newer publisher epoch
   /// restarts the time-order check (restarted() tells).
   bool receive(std::span<const std::uint8_t> payload, EventBatch& out);
+  /// As receive(), but a valid, current batch that `budget` judges late at `now_utime` is shed: it
+  /// is accounted (sequence, sensor, counts) without decoding its events, `out` is left empty and
+  /// shed() tells. Shedding costs a header's parse, so a subscriber behind catches up at once.
+  bool receive(std::span<const std::uint8_t> payload, EventBatch& out, LatencyBudget& budget, std::int64_t now_utime);
 
   /// Header of the last accepted batch (its arrays are empty: the events went to `out`).
   [[nodiscard]] const event_batch_t& message() const { return message_; }
@@ -40,10 +47,15 @@ class EventBatchReceiver {
   /// True if the last accepted batch started a new publisher epoch (not for the first batch), or its
   /// events made the validator follow a clock that went back.
   [[nodiscard]] bool restarted() const { return restarted_; }
+  /// True if the last accepted batch was shed; shed_until_us() is then the time of its last event.
+  [[nodiscard]] bool shed() const { return shed_; }
+  [[nodiscard]] Timestamp shed_until_us() const { return shed_until_us_; }
   [[nodiscard]] ReceiverCounts counts() const;
 
  private:
   void refuse(const char* why);
+  /// The checks of a decoded header (sensor size, sequence); restarts the validator with the stream.
+  bool admit();
 
   std::optional<SensorSize> sensor_;
   Timestamp slack_;
@@ -54,6 +66,9 @@ class EventBatchReceiver {
   std::uint64_t invalid_ = 0;
   event_batch_t message_;
   bool restarted_ = false;
+  bool shed_ = false;
+  Timestamp shed_until_us_ = 0;
+  std::uint64_t batches_shed_ = 0, events_shed_ = 0;
 };
 
 }  // namespace evldt

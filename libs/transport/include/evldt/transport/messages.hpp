@@ -42,6 +42,11 @@ void encode_event_batch(const event_batch_t& header, const EventBatch& events, s
 /// drops and counts those); a time base out of range (negative or above 2^62) is Malformed.
 WireError decode_event_batch(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events);
 
+/// Checks `bytes` as decode_event_batch does and sets the scalar fields of `header`, without decoding
+/// the events: `last_event_us` is the time of the batch's last event (its time base if it has none).
+/// What a subscriber needs to account a batch it sheds unread.
+WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_batch_t& header, Timestamp& last_event_us);
+
 /// Fills the segments of `msg` (header fields are the caller's).
 void fill_segment_list(std::span<const TrackedLine> lines, segment_list_t& msg);
 /// Replaces `out` with the segments of `msg`; false if any has an unknown status or a non-finite value.

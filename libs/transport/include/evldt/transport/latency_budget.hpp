@@ -1,0 +1,40 @@
+#pragma once
+// The latency budget of a live subscriber (DESIGN 9, bounded latency): an event batch that arrives
+// later than the budget is shed whole instead of queueing the ones behind it. The lattice keeps
+// only each block's newest events, so answers from a little less data beat answers a second old.
+//
+// Lateness is judged against the quickest delivery seen lately, not against the sender's clock
+// alone: a batch's delay from its publish (the sender's wall clock) to its arrival is transit plus
+// queueing plus the offset between the two clocks, and the least delay over the last seconds is
+// transit and offset. So two hosts whose clocks differ (no NTP on a robot's LAN) still shed only
+// what queued, and a clock step is forgotten within two windows.
+
+#include <cstdint>
+
+namespace evldt {
+
+class LatencyBudget {
+ public:
+  /// `max_latency_ms`: the queueing a batch may have met before it is shed; 0 never sheds.
+  /// `window_us`: how long the quickest delivery is remembered (the estimate spans one to two windows).
+  explicit LatencyBudget(double max_latency_ms, std::int64_t window_us = 2'000'000);
+
+  /// A batch published at `publish_utime` (sender's clock) arrives at `now_utime` (ours): true if it
+  /// queued longer than the budget and should be shed. Every arrival refines the estimate.
+  bool late(std::int64_t publish_utime, std::int64_t now_utime);
+
+  [[nodiscard]] double max_latency_ms() const { return static_cast<double>(budget_us_) * 1e-3; }
+  /// How long the last batch queued (its delay beyond the quickest delivery), in microseconds.
+  [[nodiscard]] std::int64_t last_queueing_us() const { return last_queueing_us_; }
+
+ private:
+  std::int64_t budget_us_;
+  std::int64_t window_us_;
+  // The least delay of the current window and of the one before it; the estimate is their minimum.
+  bool started_ = false;
+  std::int64_t window_start_ = 0;
+  std::int64_t current_min_ = 0, previous_min_ = 0;
+  std::int64_t last_queueing_us_ = 0;
+};
+
+}  // namespace evldt

@@ -1,0 +1,30 @@
+#include "evldt/transport/latency_budget.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace evldt {
+
+LatencyBudget::LatencyBudget(double max_latency_ms, std::int64_t window_us)
+    : budget_us_(std::llround(max_latency_ms * 1e3)), window_us_(window_us) {
+  if (!(max_latency_ms >= 0 && max_latency_ms <= 3.6e6) || window_us <= 0) {
+    throw std::invalid_argument("the latency budget must be in 0 .. 3600000 ms and its window positive");
+  }
+}
+
+bool LatencyBudget::late(std::int64_t publish_utime, std::int64_t now_utime) {
+  const std::int64_t delay = now_utime - publish_utime;
+  if (!started_ || now_utime - window_start_ >= window_us_ || now_utime < window_start_) {
+    // A new window (or our clock stepped back): the one that ended becomes the previous.
+    previous_min_ = started_ ? current_min_ : delay;
+    current_min_ = delay;
+    window_start_ = now_utime;
+    started_ = true;
+  }
+  current_min_ = std::min(current_min_, delay);
+  last_queueing_us_ = delay - std::min(current_min_, previous_min_);
+  return budget_us_ > 0 && last_queueing_us_ > budget_us_;
+}
+
+}  // namespace evldt
