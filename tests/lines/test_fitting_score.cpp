@@ -9,13 +9,12 @@
 namespace evldt {
 namespace {
 
-LatticeEntry entry(int x, int y, bool active = true) {
-  return {static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y | (active ? LatticeEntry::kActiveBit : 0))};
-}
+// Entries of a block whose extended region begins at the origin, so an entry's place is its pixel.
+LatticeEntry entry(int x, int y, bool active = true) { return LatticeEntry::make(x, y, active); }
 
 PointSet point_set(const std::vector<LatticeEntry>& entries, bool include_inactive) {
   PointSet points;
-  points.add(entries, include_inactive);
+  points.add(BlockEntries{entries, 0, 0}, include_inactive);
   return points;
 }
 

@@ -39,9 +39,10 @@ std::set<std::pair<int, bool>> blocks_written(std::uint16_t x, std::uint16_t y) 
   lattice.insert(x, y);
   std::set<std::pair<int, bool>> written;
   for (int block = 0; block < lattice.geometry().block_count(); ++block) {
-    for (const LatticeEntry& e : lattice.entries(block)) {
-      EXPECT_EQ(e.x, x);
-      EXPECT_EQ(e.y(), y);
+    const BlockEntries view = lattice.entries(block);
+    for (const LatticeEntry& e : view.entries) {
+      EXPECT_EQ(view.pixel_x(e), x);
+      EXPECT_EQ(view.pixel_y(e), y);
       written.insert({block, e.active()});
     }
   }
@@ -74,7 +75,7 @@ TEST(ScarfLattice, MarginPixelsAreOnlyInactive) {
   // On a 70 px wide sensor the right margin is 10 px: its outer pixels belong to no block.
   ScarfLattice wide({70, 48}, 8, 1.0);
   wide.insert(66, 20);
-  for (int block = 0; block < wide.geometry().block_count(); ++block) EXPECT_TRUE(wide.entries(block).empty());
+  for (int block = 0; block < wide.geometry().block_count(); ++block) EXPECT_TRUE(wide.entries(block).entries.empty());
 }
 
 TEST(ScarfLattice, RingKeepsNewestNAndCountsActive) {
@@ -82,7 +83,7 @@ TEST(ScarfLattice, RingKeepsNewestNAndCountsActive) {
   const auto& g = lattice.geometry();
   const int block = g.index(3, 2);
   for (int k = 0; k < 40; ++k) lattice.insert(static_cast<std::uint16_t>(30 + k % 2), 22);  // 40 active events
-  EXPECT_EQ(lattice.entries(block).size(), 32u);
+  EXPECT_EQ(lattice.entries(block).entries.size(), 32u);
   EXPECT_EQ(lattice.active_count(block), 32);
   EXPECT_EQ(lattice.surface()[22 * 64 + 30] + lattice.surface()[22 * 64 + 31], 32);
   // Inactive writes from the neighbour below push the active ones out one by one.
@@ -98,9 +99,9 @@ TEST(ScarfLattice, CopyStateGivesAnIdenticalView) {
   copy.copy_state_from(source);
   for (int block = 0; block < source.geometry().block_count(); ++block) {
     ASSERT_EQ(copy.active_count(block), source.active_count(block));
-    const auto a = source.entries(block), b = copy.entries(block);
+    const auto a = source.entries(block).entries, b = copy.entries(block).entries;
     ASSERT_EQ(a.size(), b.size());
-    for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].y_and_flag, b[i].y_and_flag);
+    for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].bits, b[i].bits);
   }
   ScarfLattice other(SensorSize{64, 64}, 8, 1.0);
   EXPECT_THROW(other.copy_state_from(source), std::invalid_argument);
@@ -109,12 +110,9 @@ TEST(ScarfLattice, CopyStateGivesAnIdenticalView) {
 void expect_same_rings(const ScarfLattice& a, const ScarfLattice& b) {
   for (int block = 0; block < a.geometry().block_count(); ++block) {
     ASSERT_EQ(a.active_count(block), b.active_count(block)) << block;
-    const auto ea = a.entries(block), eb = b.entries(block);
+    const auto ea = a.entries(block).entries, eb = b.entries(block).entries;
     ASSERT_EQ(ea.size(), eb.size()) << block;
-    for (std::size_t i = 0; i < ea.size(); ++i) {
-      ASSERT_EQ(ea[i].x, eb[i].x) << block;
-      ASSERT_EQ(ea[i].y_and_flag, eb[i].y_and_flag) << block;
-    }
+    for (std::size_t i = 0; i < ea.size(); ++i) ASSERT_EQ(ea[i].bits, eb[i].bits) << block;
   }
 }
 

@@ -28,7 +28,7 @@ void PipelineOptions::add_to(CLI::App& app) {
       ->check(CLI::Range(1, kMaxSensorSide));
   group->add_option("--height", height_, "Sensor height in pixels (default: from the recording's header)")
       ->check(CLI::Range(1, kMaxSensorSide));
-  group->add_option("--block-size", block_size_, "SCARF block size b in pixels (even)")->check(CLI::Range(2, 128));
+  group->add_option("--block-size", block_size_, "SCARF block size b in pixels (even)")->check(CLI::Range(2, 64));
   group->add_option("--alpha", alpha_, "Ring capacity factor: N = floor(alpha * b * b / 2)")
       ->check(finite_number() & CLI::PositiveNumber);
   group->add_option("--fit-threshold", fit_threshold_, "Fitting-score threshold f_th")

@@ -10,8 +10,8 @@ namespace evldt {
 
 namespace {
 
-// A LatticeEntry keeps 15 bits of y.
-static_assert(kMaxSensorSide <= 32767);
+// A LatticeEntry keeps 7 bits an axis of the place in a block's extended region (2b pixels).
+constexpr int kMaxBlockSize = 1 << (LatticeEntry::kAxisBits - 1);
 
 std::uint64_t next_lattice_id() {
   static std::atomic<std::uint64_t> next{1};
@@ -24,8 +24,9 @@ LatticeGeometry LatticeGeometry::make(SensorSize sensor, int block_size, double 
   if (!sensor.valid()) {
     throw std::invalid_argument(sensor.range_error());
   }
-  if (block_size < 2 || block_size % 2 != 0 || block_size > 128) {
-    throw std::invalid_argument("block size " + std::to_string(block_size) + " must be even and in 2..128");
+  if (block_size < 2 || block_size % 2 != 0 || block_size > kMaxBlockSize) {
+    throw std::invalid_argument("block size " + std::to_string(block_size) + " must be even and in 2.." +
+                                std::to_string(kMaxBlockSize));
   }
   if (!(alpha > 0.0) || !std::isfinite(alpha)) {
     throw std::invalid_argument("alpha must be a positive number");
@@ -57,7 +58,7 @@ int LatticeGeometry::block_at(float x, float y) const {
   return index(i, j);
 }
 
-std::vector<ScarfLattice::AxisBlocks> ScarfLattice::axis_blocks(int length, int block_size, int blocks, int stride) {
+std::vector<ScarfLattice::AxisBlocks> ScarfLattice::axis_blocks(int length, int block_size, int blocks, int stride, int shift) {
   std::vector<AxisBlocks> table(static_cast<std::size_t>(length));
   const int half = block_size / 2;
   for (int p = 0; p < length; ++p) {
@@ -66,16 +67,23 @@ std::vector<ScarfLattice::AxisBlocks> ScarfLattice::axis_blocks(int length, int 
     const int cell = shifted >= 0 ? shifted / block_size : -1;
     const int offset = shifted - cell * block_size;
     const int neighbour = offset < half ? cell - 1 : cell + 1;
-    if (cell >= 0 && cell < blocks) table[p].home = cell * stride;
-    if (neighbour >= 0 && neighbour < blocks) table[p].side = neighbour * stride;
+    // A block's extended region begins at its index times b (half a block before its active region).
+    if (cell >= 0 && cell < blocks) {
+      table[p].home = cell * stride;
+      table[p].home_bits = static_cast<std::uint16_t>((p - cell * block_size) << shift);
+    }
+    if (neighbour >= 0 && neighbour < blocks) {
+      table[p].side = neighbour * stride;
+      table[p].side_bits = static_cast<std::uint16_t>((p - neighbour * block_size) << shift);
+    }
   }
   return table;
 }
 
 ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool keep_surface)
     : geometry_(LatticeGeometry::make(sensor, block_size, alpha)), id_(next_lattice_id()) {
-  columns_ = axis_blocks(sensor.width, block_size, geometry_.blocks_x, 1);
-  rows_ = axis_blocks(sensor.height, block_size, geometry_.blocks_y, geometry_.blocks_x);
+  columns_ = axis_blocks(sensor.width, block_size, geometry_.blocks_x, 1, 0);
+  rows_ = axis_blocks(sensor.height, block_size, geometry_.blocks_y, geometry_.blocks_x, LatticeEntry::kAxisBits);
   blocks_.resize(static_cast<std::size_t>(geometry_.block_count()));
   entries_.resize(static_cast<std::size_t>(geometry_.block_count()) * geometry_.capacity);
   if (keep_surface) surface_.assign(static_cast<std::size_t>(sensor.width) * sensor.height, 0);

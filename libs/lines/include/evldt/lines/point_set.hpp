@@ -22,7 +22,7 @@ class PointSet {
     y_.clear();
   }
   /// Adds the centres of the ACTIVE entries, and of the inactive ones too when include_inactive is set.
-  void add(std::span<const LatticeEntry> entries, bool include_inactive);
+  void add(const BlockEntries& block, bool include_inactive);
   [[nodiscard]] std::size_t size() const { return x_.size(); }
   [[nodiscard]] const float* x() const { return x_.data(); }
   [[nodiscard]] const float* y() const { return y_.data(); }

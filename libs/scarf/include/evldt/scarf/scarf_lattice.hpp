@@ -19,17 +19,30 @@
 
 namespace evldt {
 
-/// One ring-buffer entry: pixel and ACTIVE flag packed into 4 bytes (y uses 15 bits).
+/// One ring-buffer entry in 2 bytes: the pixel relative to its block's extended region (which spans
+/// 2b <= 128 pixels each way, so 7 bits an axis) and the ACTIVE flag. Half the bytes of absolute
+/// coordinates: storage, the rounds' lattice snapshots and their point gathering touch half the memory.
 struct LatticeEntry {
-  std::uint16_t x = 0;
-  std::uint16_t y_and_flag = 0;
+  std::uint16_t bits = 0;
 
   static constexpr std::uint16_t kActiveBit = 0x8000;
-  [[nodiscard]] std::uint16_t y() const { return static_cast<std::uint16_t>(y_and_flag & ~kActiveBit); }
-  [[nodiscard]] bool active() const { return (y_and_flag & kActiveBit) != 0; }
-  /// Centre of the pixel in continuous image coordinates.
-  [[nodiscard]] float cx() const { return static_cast<float>(x) + 0.5f; }
-  [[nodiscard]] float cy() const { return static_cast<float>(y()) + 0.5f; }
+  static constexpr int kAxisBits = 7;
+  static constexpr LatticeEntry make(int dx, int dy, bool active) {
+    return {static_cast<std::uint16_t>(dx | (dy << kAxisBits) | (active ? kActiveBit : 0))};
+  }
+  [[nodiscard]] int dx() const { return bits & 0x7f; }
+  [[nodiscard]] int dy() const { return (bits >> kAxisBits) & 0x7f; }
+  [[nodiscard]] bool active() const { return (bits & kActiveBit) != 0; }
+};
+
+/// A block's entries and where its extended region begins: entry e lies at pixel
+/// (origin_x + e.dx(), origin_y + e.dy()).
+struct BlockEntries {
+  std::span<const LatticeEntry> entries;
+  int origin_x = 0;
+  int origin_y = 0;
+  [[nodiscard]] int pixel_x(LatticeEntry e) const { return origin_x + e.dx(); }
+  [[nodiscard]] int pixel_y(LatticeEntry e) const { return origin_y + e.dy(); }
 };
 
 /// Size and placement of the blocks. Block index = j * blocks_x + i.
@@ -84,8 +97,10 @@ class ScarfLattice {
 
   [[nodiscard]] const LatticeGeometry& geometry() const { return geometry_; }
   /// The entries a block currently holds (at most N, in no particular order).
-  [[nodiscard]] std::span<const LatticeEntry> entries(int block) const {
-    return {entries_.data() + static_cast<std::size_t>(block) * geometry_.capacity, blocks_[block].filled};
+  [[nodiscard]] BlockEntries entries(int block) const {
+    return {{entries_.data() + static_cast<std::size_t>(block) * geometry_.capacity, blocks_[block].filled},
+            geometry_.column(block) * geometry_.block_size,
+            geometry_.row(block) * geometry_.block_size};
   }
   [[nodiscard]] int active_count(int block) const { return blocks_[block].active; }
   /// When the block last changed (events written, clear), on a clock that advances once per insert
@@ -116,13 +131,17 @@ class ScarfLattice {
   };
   /// Per pixel column (row): the block column (row) whose active region holds it, and the one on
   /// the side of the half it lies in, whose extended region also holds it; -1 where there is none.
-  /// Rows are pre-multiplied by blocks_x so a block index is a single add.
+  /// Rows are pre-multiplied by blocks_x so a block index is a single add; the pixel's place in
+  /// each block's extended region is pre-shifted to its bits in an entry, so an entry is an or.
   struct AxisBlocks {
     std::int32_t home = -1;
     std::int32_t side = -1;
+    std::uint16_t home_bits = 0;
+    std::uint16_t side_bits = 0;
   };
-  /// The table of one axis of `length` pixels, `blocks` blocks, block indices scaled by `stride`.
-  static std::vector<AxisBlocks> axis_blocks(int length, int block_size, int blocks, int stride);
+  /// The table of one axis of `length` pixels, `blocks` blocks, block indices scaled by `stride`,
+  /// offsets shifted left by `shift`.
+  static std::vector<AxisBlocks> axis_blocks(int length, int block_size, int blocks, int stride, int shift);
   /// What the insert loop works with, held in locals: stores into the rings could otherwise alias
   /// members the compiler would then reload at every event.
   struct Rings {
@@ -132,6 +151,7 @@ class ScarfLattice {
     LatticeEntry* entries;
     std::uint16_t* surface;  ///< null without keep_surface
     std::size_t width;
+    int blocks_x, block_size;  ///< where an evicted entry lay, for the surface
     std::uint16_t capacity;
     std::uint64_t version;  ///< what every block this call writes takes as its version
   };
@@ -140,34 +160,42 @@ class ScarfLattice {
     copied_from_ = 0;
     ++change_clock_;
     return {columns_.data(), rows_.data(), blocks_.data(), entries_.data(), surface_.empty() ? nullptr : surface_.data(),
-            static_cast<std::size_t>(geometry_.sensor.width), static_cast<std::uint16_t>(geometry_.capacity), change_clock_};
+            static_cast<std::size_t>(geometry_.sensor.width), geometry_.blocks_x, geometry_.block_size,
+            static_cast<std::uint16_t>(geometry_.capacity), change_clock_};
   }
 
   template <bool kSurface>
   static void insert_event(const Rings& rings, std::uint16_t x, std::uint16_t y) {
     const AxisBlocks column = rings.columns[x];
     const AxisBlocks row = rings.rows[y];
-    if ((column.home | row.home) >= 0) push<kSurface, true>(rings, row.home + column.home, x, y);
-    if ((column.side | row.home) >= 0) push<kSurface, false>(rings, row.home + column.side, x, y);
-    if ((column.home | row.side) >= 0) push<kSurface, false>(rings, row.side + column.home, x, y);
-    if ((column.side | row.side) >= 0) push<kSurface, false>(rings, row.side + column.side, x, y);
+    if ((column.home | row.home) >= 0) push<kSurface, true>(rings, row.home + column.home, column.home_bits | row.home_bits, x, y);
+    if ((column.side | row.home) >= 0) push<kSurface, false>(rings, row.home + column.side, column.side_bits | row.home_bits, x, y);
+    if ((column.home | row.side) >= 0) push<kSurface, false>(rings, row.side + column.home, column.home_bits | row.side_bits, x, y);
+    if ((column.side | row.side) >= 0) push<kSurface, false>(rings, row.side + column.side, column.side_bits | row.side_bits, x, y);
   }
 
   // Branch-free bookkeeping: whether the overwritten entry was active is data (about a third of
   // entries are), and a branch on it mispredicts.
   template <bool kSurface, bool kActive>
-  static void push(const Rings& rings, std::int32_t block, std::uint16_t x, std::uint16_t y) {
+  static void push(const Rings& rings, std::int32_t block, std::uint16_t place_bits, std::uint16_t x, std::uint16_t y) {
     BlockState state = rings.blocks[block];
     LatticeEntry& slot = rings.entries[static_cast<std::size_t>(block) * rings.capacity + state.head];
     const auto full = static_cast<std::uint16_t>(state.filled == rings.capacity);
-    const auto evicted_active = static_cast<std::uint16_t>(full & (slot.y_and_flag >> 15));
+    const auto evicted_active = static_cast<std::uint16_t>(full & (slot.bits >> 15));
     if constexpr (kSurface) {
-      if (evicted_active) --rings.surface[static_cast<std::size_t>(slot.y()) * rings.width + slot.x];
+      if (evicted_active) {
+        const std::size_t ex = static_cast<std::size_t>(block % rings.blocks_x * rings.block_size + slot.dx());
+        const std::size_t ey = static_cast<std::size_t>(block / rings.blocks_x * rings.block_size + slot.dy());
+        --rings.surface[ey * rings.width + ex];
+      }
       if (kActive) ++rings.surface[static_cast<std::size_t>(y) * rings.width + x];
+    } else {
+      (void)x;
+      (void)y;
     }
     state.filled = static_cast<std::uint16_t>(state.filled + 1 - full);
     state.active = static_cast<std::uint16_t>(state.active + (kActive ? 1 : 0) - evicted_active);
-    slot = {x, static_cast<std::uint16_t>(kActive ? y | LatticeEntry::kActiveBit : y)};
+    slot = {static_cast<std::uint16_t>(kActive ? place_bits | LatticeEntry::kActiveBit : place_bits)};
     const auto next = static_cast<std::uint16_t>(state.head + 1);
     state.head = next == rings.capacity ? std::uint16_t{0} : next;
     state.version = rings.version;
