@@ -116,7 +116,10 @@ void RealtimeEngine::loop(const char* thread_name, ScarfLattice& view, Timestamp
       wake_at_us = next_due;
       while (!due()) {
         if (events_received_ == seen) {
-          lattice_changed_.wait(lock, [&] { return stopping_ || events_received_ != seen; });  // idle: no CPU
+          // Idle (no CPU): woken by any input, which may start a pause that a round must follow.
+          wake_at_us = std::numeric_limits<Timestamp>::min();
+          lattice_changed_.wait(lock, [&] { return stopping_ || events_received_ != seen; });
+          wake_at_us = next_due;
           continue;
         }
         const std::uint64_t received_before = events_received_;
