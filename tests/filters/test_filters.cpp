@@ -25,9 +25,14 @@ EventBatch batch_of(std::vector<Tagged>& events) {
   return batch;
 }
 
+/// A chain of the one filter `name`, with `config`'s parameters.
+FilterChain only(const std::string& name, FilterConfig config = {}) {
+  config.chain = {name};
+  return FilterChain(config, kSensor);
+}
+
 /// Runs `filter` over the stream in batches of `batch_size` and counts what passed of each tag.
-template <typename Filter>
-std::map<int, std::pair<int, int>> passed_by_tag(Filter& filter, std::vector<Tagged> events, std::size_t batch_size = 97) {
+std::map<int, std::pair<int, int>> passed_by_tag(FilterChain& filter, std::vector<Tagged> events, std::size_t batch_size = 97) {
   const EventBatch all = batch_of(events);
   std::map<std::tuple<Timestamp, int, int, int>, int> tag_of;
   std::map<int, std::pair<int, int>> counts;  // tag -> (passed, total)
@@ -54,7 +59,10 @@ void add_sweeping_edge(std::vector<Tagged>& events, Timestamp t0, Timestamp colu
 }
 
 TEST(BackgroundActivity, CorrelatedEdgeEventsPassIsolatedEventsDrop) {
-  BackgroundActivityFilter filter(kSensor, 2000, /*min_noise_hz=*/0);
+  FilterConfig config;
+  config.background_window_us = 2000;
+  config.background_min_noise_hz = 0;
+  FilterChain filter = only("background-activity", config);
   std::vector<Tagged> events;
   add_sweeping_edge(events, 10'000, 500, /*tag=*/0);
   // Isolated events: pixels far apart, each alone in its neighbourhood for far longer than the window.
@@ -64,7 +72,7 @@ TEST(BackgroundActivity, CorrelatedEdgeEventsPassIsolatedEventsDrop) {
   const auto counts = passed_by_tag(filter, events);
   EXPECT_GE(counts.at(0).first, counts.at(0).second - 1);  // all but the very first event of the edge
   EXPECT_EQ(counts.at(1).first, 0);
-  EXPECT_EQ(filter.dropped(), static_cast<std::uint64_t>(counts.at(0).second - counts.at(0).first + 200));
+  EXPECT_EQ(filter.counts().background_activity, static_cast<std::uint64_t>(counts.at(0).second - counts.at(0).first + 200));
 }
 
 /// Isolated events at `hz` per pixel over the whole sensor, each alone in its neighbourhood.
@@ -77,7 +85,10 @@ void add_uncorrelated(std::vector<Tagged>& events, double hz, Timestamp from, Ti
 }
 
 TEST(BackgroundActivity, DropsUncorrelatedEventsOnlyWhileTheSensorIsNoisy) {
-  BackgroundActivityFilter filter(kSensor, 2000, /*min_noise_hz=*/1.0);
+  FilterConfig config;
+  config.background_window_us = 2000;
+  config.background_min_noise_hz = 1.0;
+  FilterChain filter = only("background-activity", config);
   std::vector<Tagged> events;
   add_uncorrelated(events, 0.3, 0, 1'000'000, /*tag=*/0);          // a clean sensor's sparse events: kept
   add_uncorrelated(events, 5.0, 1'000'000, 1'200'000, /*tag=*/1);  // noise begins: judged over 200 ms
@@ -88,7 +99,9 @@ TEST(BackgroundActivity, DropsUncorrelatedEventsOnlyWhileTheSensorIsNoisy) {
 }
 
 TEST(Refractory, APixelFiresAtMostOncePerPeriod) {
-  RefractoryFilter filter(kSensor, 100);
+  FilterConfig config;
+  config.refractory_us = 100;
+  FilterChain filter = only("refractory", config);
   std::vector<Tagged> events;
   for (int i = 0; i < 10; ++i) events.push_back({{1000 + 50 * i, 3, 4, 1}, i % 2});  // even ones are 100 us apart
   events.push_back({{1010, 5, 4, 1}, 0});  // another pixel, unaffected
@@ -98,8 +111,7 @@ TEST(Refractory, APixelFiresAtMostOncePerPeriod) {
 }
 
 TEST(HotPixel, MaskedWithinItsLearningTimeAndReleasedWhenItCools) {
-  HotPixelParams params;  // windows of 200 ms, hot above 200 Hz and 8x its neighbours
-  HotPixelFilter filter(kSensor, params);
+  FilterChain filter = only("hot-pixel");  // windows of 200 ms, hot above 200 Hz and 8x its neighbours
   std::vector<Tagged> events;
   // The hot pixel fires at 2 kHz for 1 s, then at 20 Hz (cooled) for 1 s.
   for (Timestamp t = 0; t < 1'000'000; t += 500) events.push_back({{t, 10, 10, 1}, t < 400'000 ? 0 : 1});
@@ -119,7 +131,7 @@ TEST(HotPixel, MaskedWithinItsLearningTimeAndReleasedWhenItCools) {
 }
 
 TEST(HotPixel, AMaskedPixelIsListedWhileHot) {
-  HotPixelFilter filter(kSensor, HotPixelParams{});
+  FilterChain filter = only("hot-pixel");
   EventBatch batch;
   for (Timestamp t = 0; t < 500'000; t += 400) batch.push_back(t, 63, 47, -1);  // a corner pixel: 3 neighbours
   EventBatch passed;
@@ -146,7 +158,7 @@ void add_flicker(std::vector<Tagged>& events, Timestamp from, Timestamp to, doub
 }
 
 TEST(AntiFlicker, A100HzBurstTrainIsRemovedWhileAnEdgeUnderItIsKept) {
-  AntiFlickerFilter filter(kSensor, AntiFlickerParams{});
+  FilterChain filter = only("anti-flicker");
   std::vector<Tagged> events;
   add_flicker(events, 0, 50'000, 100, /*tag=*/0);           // locking on: 3 periods
   add_flicker(events, 50'000, 1'000'000, 100, /*tag=*/1);   // locked
@@ -158,7 +170,7 @@ TEST(AntiFlicker, A100HzBurstTrainIsRemovedWhileAnEdgeUnderItIsKept) {
 }
 
 TEST(AntiFlicker, FlickerOutsideTheBandAndIrregularEventsPass) {
-  AntiFlickerFilter filter(kSensor, AntiFlickerParams{});  // 50-520 Hz
+  FilterChain filter = only("anti-flicker");  // 50-520 Hz
   std::vector<Tagged> events;
   add_flicker(events, 0, 1'000'000, 20, /*tag=*/0);  // 20 Hz: below the band
   // A pixel firing at irregular intervals in the band's range.
@@ -200,6 +212,12 @@ TEST(FilterChain, RunsInOrderAndCountsEachReason) {
   EXPECT_THROW(parse_filter_chain("hot-pixel,hot-pixel"), std::invalid_argument);
   EXPECT_THROW(parse_filter_chain("hot-pixel,"), std::invalid_argument);
   config.background_window_us = 0;
+  EXPECT_THROW(FilterChain(config, kSensor), std::invalid_argument);
+  config.background_window_us = 5000;
+  config.chain = {"refractory", "hot-pixel", "refractory"};  // a repeated filter: refused
+  EXPECT_THROW(FilterChain(config, kSensor), std::invalid_argument);
+  config.chain = {"refractory"};
+  config.refractory_us = 1'000'000'001;  // above 1000 s: refused (the filter keeps 32-bit times)
   EXPECT_THROW(FilterChain(config, kSensor), std::invalid_argument);
 }
 

@@ -1,6 +1,11 @@
 #include "evldt/filters/filter_chain.hpp"
 
+#include <sys/mman.h>
+
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <new>
 #include <stdexcept>
 
 namespace evldt {
@@ -34,56 +39,174 @@ std::string format_filter_chain(const std::vector<std::string>& chain) {
 }
 
 void check_filter_config(const FilterConfig& config) {
-  for (const std::string& name : config.chain) {
-    if (std::ranges::find(filter_names(), name) == filter_names().end()) throw std::invalid_argument("unknown filter '" + name + "'");
+  for (auto name = config.chain.begin(); name != config.chain.end(); ++name) {
+    if (std::ranges::find(filter_names(), *name) == filter_names().end()) throw std::invalid_argument("unknown filter '" + *name + "'");
+    if (std::find(config.chain.begin(), name, *name) != name) throw std::invalid_argument("filter '" + *name + "' given twice");
   }
-  if (config.background_window_us <= 0) throw std::invalid_argument("the background-activity window must be positive");
+  if (config.background_window_us <= 0 || config.background_window_us > 1'000'000'000) {
+    throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
+  }
   if (!(config.background_min_noise_hz >= 0)) throw std::invalid_argument("the background-activity noise level must not be negative");
-  if (config.refractory_us <= 0) throw std::invalid_argument("the refractory period must be positive");
+  if (config.refractory_us <= 0 || config.refractory_us > 1'000'000'000) throw std::invalid_argument("the refractory period must be in 1 us .. 1000 s");
   check_params(config.hot_pixel);
   check_params(config.anti_flicker);
 }
 
-FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) {
-  check_filter_config(config);
-  for (const std::string& name : config.chain) {
-    if (name == "hot-pixel") {
-      auto filter = std::make_unique<HotPixelFilter>(sensor, config.hot_pixel);
-      hot_pixel_ = filter.get();
-      filters_.push_back(std::move(filter));
-    } else if (name == "background-activity") {
-      filters_.push_back(std::make_unique<BackgroundActivityFilter>(sensor, config.background_window_us, config.background_min_noise_hz));
-    } else if (name == "refractory") {
-      filters_.push_back(std::make_unique<RefractoryFilter>(sensor, config.refractory_us));
-    } else {
-      filters_.push_back(std::make_unique<AntiFlickerFilter>(sensor, config.anti_flicker));
+namespace {
+
+// Events ahead whose state is fetched into the cache while the current one is tested: at the larger
+// sensor sizes the table is far larger than the caches and events land all over it, so without
+// this each event waits for memory (measured: twice the throughput at 1280x720).
+constexpr std::size_t kPrefetchAhead = 16;
+
+// The table is allocated in whole huge pages and asks the kernel for transparent huge pages, where
+// it offers them: events land all over a table far larger than what the TLB covers with 4 KiB pages
+// (measured: 15% more throughput at 640x480 and 1280x720).
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+
+void* allocate_zeroed(std::size_t bytes) {
+  const std::size_t size = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  void* const memory = std::aligned_alloc(kHugePage, size);
+  if (memory == nullptr) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+  madvise(memory, size, MADV_HUGEPAGE);  // a hint: without it, 4 KiB pages
+#endif
+  std::memset(memory, 0, bytes);
+  return memory;
+}
+
+}  // namespace
+
+// The filters in a given order, as a compile-time list: the pass over a batch is instantiated for
+// each of the 65 orders (none to four distinct filters), so each event's tests inline into one
+// loop with no dispatch per event.
+template <filter_chain_detail::Kind... Ks>
+struct FilterChain::Pass {
+  static constexpr bool kRecords = ((Ks != Kind::BackgroundActivity) || ...);
+  static constexpr bool kSurface = ((Ks == Kind::BackgroundActivity) || ...);
+
+  static void run(FilterChain& chain, const EventBatch& in, EventBatch& out) {
+    const std::size_t size = in.size();
+    if (&in != &out) out.truncate(size);  // room for every event: no allocation once warm
+    const Timestamp* const ts = in.t.data();
+    const std::uint16_t *const xs = in.x.data(), *const ys = in.y.data();
+    const std::int8_t* const ps = in.p.data();
+    Timestamp* const out_t = out.t.data();
+    std::uint16_t *const out_x = out.x.data(), *const out_y = out.y.data();
+    std::int8_t* const out_p = out.p.data();
+    std::byte* const table = chain.table_.get();
+    auto* const states = reinterpret_cast<PixelState*>(table);
+    auto* const surface = reinterpret_cast<std::uint32_t*>(table + chain.surface_offset_);
+    const auto width = static_cast<std::size_t>(chain.width_);
+    const std::size_t stride = chain.surface_stride_;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < size; ++i) {
+      if (i + kPrefetchAhead < size) {
+        const std::size_t ax = xs[i + kPrefetchAhead], ay = ys[i + kPrefetchAhead];
+        if constexpr (kRecords) __builtin_prefetch(states + ay * width + ax, 1);
+        if constexpr (kSurface) {
+          const std::uint32_t* const row = surface + ay * stride + ax;  // the row above, from the left neighbour
+          __builtin_prefetch(row);
+          __builtin_prefetch(row + 2);
+          __builtin_prefetch(row + stride, 1);
+          __builtin_prefetch(row + stride + 2, 1);
+          __builtin_prefetch(row + 2 * stride);
+          __builtin_prefetch(row + 2 * stride + 2);
+        }
+      }
+      const Timestamp t = ts[i];
+      const std::uint16_t x = xs[i], y = ys[i];
+      const std::int8_t p = ps[i];
+      [[maybe_unused]] const auto pixel = static_cast<std::uint32_t>(y * width + x);
+      // In order, up to the first that drops the event.
+      if (!(test<Ks>(chain, t, x, y, p, pixel, states, surface, stride) && ...)) continue;
+      out_t[kept] = t;  // kept <= i: safe in place
+      out_x[kept] = x;
+      out_y[kept] = y;
+      out_p[kept] = p;
+      ++kept;
     }
+    out.truncate(kept);
+    chain.passed_ += kept;
+  }
+
+  template <Kind K>
+  static bool test(FilterChain& chain, Timestamp t, std::size_t x, std::size_t y, std::int8_t p, std::uint32_t pixel, PixelState* states,
+                   std::uint32_t* surface, std::size_t stride) {
+    if constexpr (K == Kind::HotPixel) {
+      return chain.hot_pixel_->pass(t, pixel, states);
+    } else if constexpr (K == Kind::AntiFlicker) {
+      return chain.anti_flicker_->pass(t, states[pixel].flicker[p > 0 ? 1 : 0]);
+    } else if constexpr (K == Kind::BackgroundActivity) {
+      return chain.background_activity_->pass(t, surface + (y + 1) * stride + x + 1);
+    } else {
+      return chain.refractory_->pass(t, pixel, states);
+    }
+  }
+};
+
+template <filter_chain_detail::Kind... Ks>
+void FilterChain::add_passes(std::array<PassFunction, kOrderCodes>& passes) {
+  passes[order_code<Ks...>()] = &Pass<Ks...>::run;
+  if constexpr (sizeof...(Ks) < 4) {
+    if constexpr (((Ks != Kind::HotPixel) && ...)) add_passes<Ks..., Kind::HotPixel>(passes);
+    if constexpr (((Ks != Kind::BackgroundActivity) && ...)) add_passes<Ks..., Kind::BackgroundActivity>(passes);
+    if constexpr (((Ks != Kind::Refractory) && ...)) add_passes<Ks..., Kind::Refractory>(passes);
+    if constexpr (((Ks != Kind::AntiFlicker) && ...)) add_passes<Ks..., Kind::AntiFlicker>(passes);
   }
 }
 
+FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) : width_(sensor.width) {
+  check_filter_config(config);
+  std::size_t code = 0, digit = 1;
+  for (const std::string& name : config.chain) {
+    Kind kind = Kind::AntiFlicker;
+    if (name == "hot-pixel") {
+      hot_pixel_.emplace(sensor, config.hot_pixel);
+      kind = Kind::HotPixel;
+    } else if (name == "background-activity") {
+      background_activity_.emplace(sensor, config.background_window_us, config.background_min_noise_hz);
+      kind = Kind::BackgroundActivity;
+    } else if (name == "refractory") {
+      refractory_.emplace(sensor, config.refractory_us);
+      kind = Kind::Refractory;
+    } else {
+      anti_flicker_.emplace(config.anti_flicker);
+    }
+    code += digit * (static_cast<std::size_t>(kind) + 1);
+    digit *= 5;
+  }
+  static const std::array<PassFunction, kOrderCodes> passes = [] {
+    std::array<PassFunction, kOrderCodes> all{};
+    add_passes<>(all);
+    return all;
+  }();
+  pass_ = passes[code];
+  const std::size_t pixels = static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height);
+  const std::size_t record_bytes = hot_pixel_ || refractory_ || anti_flicker_ ? pixels * sizeof(PixelState) : 0;
+  const std::size_t surface_bytes = background_activity_ ? BackgroundActivityFilter::surface_size(sensor) * sizeof(std::uint32_t) : 0;
+  if (record_bytes + surface_bytes > 0) {
+    table_.reset(static_cast<std::byte*>(allocate_zeroed(record_bytes + surface_bytes)));
+    surface_offset_ = record_bytes;
+    surface_stride_ = BackgroundActivityFilter::surface_stride(sensor);
+  }
+}
+
+void FilterChain::Free::operator()(std::byte* memory) const { std::free(memory); }
+
 void FilterChain::filter(const EventBatch& in, EventBatch& out) {
   events_in_ += in.size();
-  // The first filter copies what passes, the others filter that copy in place.
-  const EventBatch* from = &in;
-  for (const auto& filter : filters_) {
-    filter->filter(*from, out);
-    from = &out;
-  }
-  passed_ += out.size();
+  pass_(*this, in, out);
 }
 
 FilterCounts FilterChain::counts() const {
   FilterCounts counts;
   counts.events_in = events_in_;
   counts.passed = passed_;
-  for (const auto& filter : filters_) {
-    const std::string_view name = filter->name();
-    std::uint64_t& reason = name == "hot-pixel"             ? counts.hot_pixel
-                            : name == "background-activity" ? counts.background_activity
-                            : name == "refractory"          ? counts.refractory
-                                                            : counts.anti_flicker;
-    reason = filter->dropped();
-  }
+  if (hot_pixel_) counts.hot_pixel = hot_pixel_->dropped();
+  if (background_activity_) counts.background_activity = background_activity_->dropped();
+  if (refractory_) counts.refractory = refractory_->dropped();
+  if (anti_flicker_) counts.anti_flicker = anti_flicker_->dropped();
   return counts;
 }
 

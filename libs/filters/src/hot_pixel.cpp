@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "evldt/filters/noise_filters.hpp"
@@ -7,13 +8,13 @@
 namespace evldt {
 
 HotPixelFilter::HotPixelFilter(SensorSize sensor, const HotPixelParams& params)
-    : EventFilter(sensor),
+    : sensor_(sensor),
       params_(params),
       min_count_(static_cast<std::uint32_t>(std::max(2.0, std::ceil(params.min_rate_hz * static_cast<double>(params.window_us) * 1e-6)))),
       release_count_(std::max<std::uint32_t>(1, min_count_ / 2)),
-      counts_(pixels(), 0) {
+      window_end_(std::numeric_limits<Timestamp>::min()),
+      touched_(std::make_unique_for_overwrite<std::uint32_t[]>(static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height))) {
   check_params(params);
-  touched_.reserve(pixels());
 }
 
 void check_params(const HotPixelParams& params) {
@@ -22,40 +23,27 @@ void check_params(const HotPixelParams& params) {
   }
 }
 
-void HotPixelFilter::filter(const EventBatch& in, EventBatch& out) {
-  keep_if(in, out, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t) {
-    if (!started_) {
-      started_ = true;
-      window_end_ = t + params_.window_us;
-    }
-    if (t >= window_end_) {
-      judge_window();
-      // The next window follows on, unless a gap in event time left it behind.
-      window_end_ = t - window_end_ < params_.window_us ? window_end_ + params_.window_us : t + params_.window_us;
-    }
-    const std::size_t i = pixel(x, y);
-    std::uint32_t& count = counts_[i];
-    if ((count & ~kMasked) == 0) touched_.push_back(static_cast<std::uint32_t>(i));
-    ++count;  // the count stays far below kMasked: a window of a few seconds at any real rate
-    return (count & kMasked) == 0;
-  });
-}
-
-void HotPixelFilter::judge_window() {
+void HotPixelFilter::end_window(Timestamp t, PixelState* states) {
+  if (!started_) {
+    started_ = true;
+    window_end_ = t + params_.window_us;
+    return;
+  }
   // A masked pixel stays masked while it still fires at half the hot rate; below that it has cooled.
   still_masked_.clear();
   for (const std::uint32_t i : masked_list_) {
-    if ((counts_[i] & ~kMasked) >= release_count_) {
+    if ((states[i].hot_pixel & ~kMasked) >= release_count_) {
       still_masked_.push_back(i);
     } else {
-      counts_[i] &= ~kMasked;
+      states[i].hot_pixel &= ~kMasked;
     }
   }
   masked_list_.swap(still_masked_);
   const int width = sensor_.width, height = sensor_.height;
-  for (const std::uint32_t i : touched_) {
-    const std::uint32_t count = counts_[i] & ~kMasked;
-    if (count < min_count_ || (counts_[i] & kMasked) != 0) continue;
+  const std::span<const std::uint32_t> touched(touched_.get(), touched_count_);
+  for (const std::uint32_t i : touched) {
+    const std::uint32_t count = states[i].hot_pixel & ~kMasked;
+    if (count < min_count_ || (states[i].hot_pixel & kMasked) != 0) continue;
     const int x = static_cast<int>(i % static_cast<std::uint32_t>(width)), y = static_cast<int>(i / static_cast<std::uint32_t>(width));
     std::uint64_t sum = 0;
     int neighbours = 0;
@@ -63,16 +51,18 @@ void HotPixelFilter::judge_window() {
       for (int dx = -1; dx <= 1; ++dx) {
         const int nx = x + dx, ny = y + dy;
         if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-        sum += counts_[static_cast<std::size_t>(ny) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nx)] & ~kMasked;
+        sum += states[static_cast<std::size_t>(ny) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nx)].hot_pixel & ~kMasked;
         ++neighbours;
       }
     }
     const double neighbour_mean = static_cast<double>(sum) / std::max(neighbours, 1);
     if (static_cast<double>(count) > params_.neighbour_ratio * (neighbour_mean + 1.0)) masked_list_.push_back(i);
   }
-  for (const std::uint32_t i : touched_) counts_[i] = 0;
-  for (const std::uint32_t i : masked_list_) counts_[i] = kMasked;
-  touched_.clear();
+  for (const std::uint32_t i : touched) states[i].hot_pixel = 0;
+  for (const std::uint32_t i : masked_list_) states[i].hot_pixel = kMasked;
+  touched_count_ = 0;
+  // The next window follows on, unless a gap in event time left it behind.
+  window_end_ = t - window_end_ < params_.window_us ? window_end_ + params_.window_us : t + params_.window_us;
 }
 
 }  // namespace evldt

@@ -2,7 +2,10 @@
 // The noise filters a pipeline runs before storage, built from a configuration and applied in the
 // configured order; what each dropped is counted under its name.
 
+#include <array>
+#include <cstddef>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -29,7 +32,8 @@ std::vector<std::string> parse_filter_chain(const std::string& text);
 /// "hot-pixel,background-activity", or "none".
 std::string format_filter_chain(const std::vector<std::string>& chain);
 
-/// Throws std::invalid_argument, with the reason, for a configuration a chain cannot be built from.
+/// Throws std::invalid_argument, with the reason, for a configuration a chain cannot be built from
+/// (an unknown or repeated filter, a parameter out of range).
 void check_filter_config(const FilterConfig& config);
 
 /// Events in and passed, and dropped by each filter.
@@ -52,21 +56,59 @@ struct FilterCounts {
   }
 };
 
+namespace filter_chain_detail {
+enum class Kind : std::uint8_t { HotPixel, BackgroundActivity, Refractory, AntiFlicker };
+}  // namespace filter_chain_detail
+
 class FilterChain {
  public:
   /// Throws std::invalid_argument for an unknown filter or a parameter out of range.
   FilterChain(const FilterConfig& config, SensorSize sensor);
   /// Writes to `out` the events of `in` (on-sensor, in time order) that pass every filter, in order;
-  /// `out` may be `in`. The chain must not be empty.
+  /// `out` may be `in`. The chain must not be empty. Once `out` has held a batch as large, no
+  /// allocation.
   void filter(const EventBatch& in, EventBatch& out);
-  [[nodiscard]] bool empty() const { return filters_.empty(); }
+  [[nodiscard]] bool empty() const { return !hot_pixel_ && !background_activity_ && !refractory_ && !anti_flicker_; }
   [[nodiscard]] FilterCounts counts() const;
   /// The pixels the hot-pixel filter masks now (y * width + x); empty without that filter.
   [[nodiscard]] std::span<const std::uint32_t> masked_pixels() const;
 
  private:
-  std::vector<std::unique_ptr<EventFilter>> filters_;
-  const HotPixelFilter* hot_pixel_ = nullptr;
+  using Kind = filter_chain_detail::Kind;
+  // One pass per batch: each event meets the filters in order until one drops it, so each filter
+  // sees exactly the events the ones before it passed, in order, whatever the batch sizes.
+  template <Kind... Ks>
+  struct Pass;
+  using PassFunction = void (*)(FilterChain&, const EventBatch&, EventBatch&);
+  // An order as a number: the k-th filter's kind (counted from 1) in base-5 digit k.
+  static constexpr std::size_t kOrderCodes = 5 * 5 * 5 * 5;
+  template <Kind... Ks>
+  static constexpr std::size_t order_code() {
+    std::size_t code = 0, digit = 1;
+    ((code += digit * (static_cast<std::size_t>(Ks) + 1), digit *= 5), ...);
+    return code;
+  }
+  /// Enters the pass of every order that starts with Ks.
+  template <Kind... Ks>
+  static void add_passes(std::array<PassFunction, kOrderCodes>& passes);
+
+  PassFunction pass_;
+  std::optional<HotPixelFilter> hot_pixel_;
+  std::optional<BackgroundActivityFilter> background_activity_;
+  std::optional<RefractoryFilter> refractory_;
+  std::optional<AntiFlickerFilter> anti_flicker_;
+  // The per-pixel state of every filter, in one allocation made and zeroed (nothing seen) once:
+  // a 32-byte record per pixel (y * width + x) for hot-pixel, refractory and anti-flicker, then
+  // background-activity's last-event times as a plane with a one-pixel border, so that its 3x3
+  // neighbourhood lies on 3 rows of 4-byte cells (3 cache lines, not the 6 its times would span
+  // as part of the records).
+  struct Free {
+    void operator()(std::byte* memory) const;
+  };
+  std::unique_ptr<std::byte, Free> table_;
+  std::size_t surface_offset_ = 0;  // bytes
+  int width_;
+  std::size_t surface_stride_ = 0;
   std::uint64_t events_in_ = 0, passed_ = 0;
 };
 
