@@ -140,6 +140,45 @@ FormatError expect_format_error(Decode&& decode) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
+// The decoders' appender
+
+TEST(EventBatchAppender, AppendsAfterTheEventsThereAsPushBackWouldAcrossBlocks) {
+  EventBatch batch, expected;
+  batch.push_back(7, 1, 2, -1);
+  expected.push_back(7, 1, 2, -1);
+  {
+    EventBatch::Appender out(batch);
+    for (int i = 0; i < 5000; ++i) {
+      const Event e{i, static_cast<std::uint16_t>(i % 1280), static_cast<std::uint16_t>(i % 720), i % 3 ? std::int8_t{1} : std::int8_t{-1}};
+      out.push_back(e);
+      expected.push_back(e);
+    }
+    EXPECT_EQ(out.size(), 5001u);
+  }
+  EXPECT_EQ(events_of(batch), events_of(expected));
+  EXPECT_EQ(batch.x.size(), 5001u);
+  EXPECT_EQ(batch.y.size(), 5001u);
+  EXPECT_EQ(batch.p.size(), 5001u);
+  { EventBatch::Appender nothing(batch); }  // appending nothing changes nothing
+  EXPECT_EQ(events_of(batch), events_of(expected));
+}
+
+TEST(EventBatchAppender, AnExceptionLeavesTheEventsAppendedBeforeIt) {
+  EventBatch batch;
+  try {
+    EventBatch::Appender out(batch);
+    for (int i = 0; i < 1500; ++i) out.push_back(i, 1, 1, 1);
+    throw FormatError("memory", 3, "bad");
+  } catch (const FormatError&) {
+  }
+  ASSERT_EQ(batch.size(), 1500u);
+  EXPECT_EQ(batch.x.size(), 1500u);
+  EXPECT_EQ(batch.y.size(), 1500u);
+  EXPECT_EQ(batch.p.size(), 1500u);
+  EXPECT_EQ(batch.t.back(), 1499);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
 // Names
 
 TEST(EventFormat, ParsesNamesAndPrintsThemBack) {

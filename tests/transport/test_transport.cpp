@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <random>
 #include <thread>
 
 #include "evldt/transport/channels.hpp"
@@ -274,6 +275,27 @@ TEST(Messages, BatchSpanBeyondInt32IsRejectedOnEncode) {
   EXPECT_THROW(encode_event_batch(event_batch_t{}, events, bytes), std::invalid_argument);
 }
 
+TEST(Messages, BatchSpanUpToInt32EitherWayIsEncodedAsLcmGenDoes) {
+  for (const Timestamp base : {Timestamp{0}, Timestamp{5'000'000'000}, Timestamp{-7}}) {
+    EventBatch events;
+    events.push_back(base, 1, 2, 1);
+    events.push_back(base + kMaxBatchSpanUs, 3, 4, -1);
+    events.push_back(base - kMaxBatchSpanUs, 65535, 0, 1);  // out of order: encoded all the same
+    for (std::size_t i = 0; i < 37; ++i) events.push_back(base + static_cast<Timestamp>(i) * 70000, static_cast<std::uint16_t>(i * 1000), 719, -1);
+    std::vector<std::uint8_t> bytes{1, 2, 3};
+    encode_event_batch(make_batch(events, 1), events, bytes);
+    EXPECT_EQ(bytes, encode(make_batch(events, 1))) << base;
+    for (const Timestamp beyond : {base + kMaxBatchSpanUs + 1, base - kMaxBatchSpanUs - 1, base + (Timestamp{1} << 32),
+                                   base + (Timestamp{1} << 32) + 5, base - (Timestamp{1} << 32)}) {
+      EventBatch bad = events;
+      bad.push_back(beyond, 1, 1, 1);
+      std::vector<std::uint8_t> untouched = bytes;
+      EXPECT_THROW(encode_event_batch(event_batch_t{}, bad, untouched), std::invalid_argument) << beyond - base;
+      EXPECT_EQ(untouched, bytes);  // nothing written before the refusal
+    }
+  }
+}
+
 // ---- channels -----------------------------------------------------------------------------------
 
 TEST(Channels, NamesAreUpperCaseAndCameraNamesChecked) {
@@ -319,6 +341,125 @@ TEST(EventBatcher, KeepsEveryEventInOrderAcrossManyPushes) {
   while (batcher.pop(out, true)) popped.insert(popped.end(), out.t.begin(), out.t.end());
   ASSERT_EQ(popped.size(), 50u * 37u);
   for (std::size_t i = 0; i < popped.size(); ++i) ASSERT_EQ(popped[i], 1000 + static_cast<Timestamp>(i) * 5);
+}
+
+// EventBatcher as it was with one buffer (append on push, copy on pop, the consumed prefix erased):
+// the reference for its batches.
+class ReferenceBatcher {
+ public:
+  ReferenceBatcher(Timestamp window_us, std::size_t max_events) : window_us_(window_us), max_events_(max_events) {}
+  void push(const EventBatch& events) {
+    if (head_ > 0 && head_ * 2 >= buffer_.size()) {
+      EventBatch rest;
+      rest.append(buffer_, head_, buffer_.size());
+      buffer_ = rest;
+      head_ = 0;
+    }
+    buffer_.append(events, 0, events.size());
+  }
+  bool pop(EventBatch& out, bool flush) {
+    out.clear();
+    if (pending() == 0) return false;
+    const Timestamp first = buffer_.t[head_];
+    const Timestamp index = first >= 0 ? first / window_us_ : -((-first - 1) / window_us_) - 1;
+    const Timestamp end_t = (index + 1) * window_us_;
+    std::size_t end = head_;
+    while (end < buffer_.size() && end - head_ < max_events_ && buffer_.t[end] < end_t) ++end;
+    const bool complete = end < buffer_.size() || end - head_ == max_events_;
+    if (!complete && !flush) return false;
+    out.append(buffer_, head_, end);
+    head_ = end;
+    return true;
+  }
+  [[nodiscard]] std::size_t pending() const { return buffer_.size() - head_; }
+
+ private:
+  Timestamp window_us_;
+  std::size_t max_events_;
+  EventBatch buffer_;
+  std::size_t head_ = 0;
+};
+
+std::vector<Event> events_of(const EventBatch& batch) {
+  std::vector<Event> events;
+  for (std::size_t i = 0; i < batch.size(); ++i) events.push_back(batch[i]);
+  return events;
+}
+
+TEST(EventBatcher, BatchesAsTheSingleBufferBatcherDidAcrossWindowAndSizeBoundaries) {
+  std::mt19937_64 random(20251202);
+  std::uniform_int_distribution<int> percent(0, 99);
+  for (const Timestamp window : {Timestamp{1}, Timestamp{7}, Timestamp{1000}}) {
+    for (const std::size_t max_events : {std::size_t{1}, std::size_t{3}, std::size_t{64}, std::size_t{7000}}) {
+      SCOPED_TRACE(testing::Message() << "window " << window << " max " << max_events);
+      EventBatcher batcher(window, max_events);
+      ReferenceBatcher reference(window, max_events);
+      Timestamp t = -5000;  // windows before 0 too
+      EventBatch chunk, out, expected;
+      std::size_t popped = 0;
+      for (int round = 0; round < 300; ++round) {
+        // Chunks of 0 to 2000 events, times in order but for steps back within a few us (the
+        // validator's slack lets those through), some pushed by copy, some handed over.
+        chunk.clear();
+        const std::size_t n = std::uniform_int_distribution<std::size_t>(0, percent(random) < 10 ? 2000 : 40)(random);
+        for (std::size_t i = 0; i < n; ++i) {
+          t += std::uniform_int_distribution<Timestamp>(0, window * 3)(random);
+          const Timestamp jitter = percent(random) < 5 ? std::uniform_int_distribution<Timestamp>(0, 3)(random) : 0;
+          chunk.push_back(t - jitter, static_cast<std::uint16_t>(i), static_cast<std::uint16_t>(round), i % 2 ? std::int8_t{1} : std::int8_t{-1});
+        }
+        reference.push(chunk);
+        if (percent(random) < 50) {
+          batcher.push(chunk);
+        } else {
+          batcher.push(std::move(chunk));
+          EXPECT_TRUE(chunk.empty());
+        }
+        ASSERT_EQ(batcher.pending(), reference.pending());
+        // Pop some or all of the complete batches, now and then flushing the tail too.
+        const bool flush = percent(random) < 5;
+        const int pops = percent(random) < 70 ? 1000000 : percent(random) % 4;
+        for (int p = 0; p < pops; ++p) {
+          const bool got = batcher.pop(out, flush);
+          ASSERT_EQ(got, reference.pop(expected, flush)) << "round " << round << " pop " << p;
+          ASSERT_EQ(events_of(out), events_of(expected)) << "round " << round << " pop " << p;
+          ASSERT_EQ(batcher.pending(), reference.pending());
+          if (!got) break;
+          popped += out.size();
+        }
+      }
+      while (batcher.pop(out, true)) {
+        ASSERT_TRUE(reference.pop(expected, true));
+        ASSERT_EQ(events_of(out), events_of(expected));
+        popped += out.size();
+      }
+      EXPECT_FALSE(reference.pop(expected, true));
+      EXPECT_EQ(batcher.pending(), 0u);
+      EXPECT_GT(popped, 0u);
+    }
+  }
+}
+
+TEST(EventBatcher, HandedOverChunksComeBackEmptyWithTheStorageOfConsumedOnes) {
+  EventBatcher batcher(1000, 7000);
+  EventBatch chunk = make_events(5000, 0, 1);  // 0..4999 us: windows 0..4 complete once 5000 arrives
+  batcher.push(std::move(chunk));
+  EXPECT_TRUE(chunk.empty());
+  EXPECT_EQ(batcher.pending(), 5000u);
+  chunk = make_events(10, 5000, 1);
+  batcher.push(std::move(chunk));
+  EventBatch out;
+  std::size_t popped = 0;
+  while (batcher.pop(out)) popped += out.size();
+  EXPECT_EQ(popped, 5000u);
+  EXPECT_EQ(batcher.pending(), 10u);
+  chunk = make_events(3, 6000, 1);
+  batcher.push(std::move(chunk));
+  EXPECT_TRUE(chunk.empty());
+  EXPECT_GE(chunk.t.capacity(), 5000u);  // the first chunk's columns, ready to be filled again
+  ASSERT_TRUE(batcher.pop(out));
+  EXPECT_EQ(out.t, make_events(10, 5000, 1).t);
+  ASSERT_TRUE(batcher.pop(out, true));
+  EXPECT_EQ(out.t, make_events(3, 6000, 1).t);
 }
 
 TEST(EventBatcher, RefusesZeroWindowOrSize) {

@@ -78,7 +78,8 @@ class Aedat31Decoder final : public EventDecoder {
  public:
   explicit Aedat31Decoder(std::string source) : source_(std::move(source)), header_('#') {}
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     if (!header_.complete()) {
       if (!header_.take(chunk, source_)) return;
       read_header();
@@ -152,7 +153,7 @@ class Aedat31Decoder final : public EventDecoder {
     if (!polarity_packet_) ++counts_.skipped_words;  // a packet of another type, skipped whole
   }
 
-  void decode_event(const std::uint8_t* event, EventBatch& out) {
+  void decode_event(const std::uint8_t* event, EventBatch::Appender& out) {
     const std::uint32_t data = load_le32(event);
     if ((data & 1u) == 0) {
       ++counts_.skipped_words;
@@ -186,7 +187,8 @@ class Aedat2Decoder final : public EventDecoder {
  public:
   explicit Aedat2Decoder(std::string source) : source_(std::move(source)), header_('#') {}
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     if (!header_.complete()) {
       if (!header_.take(chunk, source_)) return;
       read_header();
@@ -214,7 +216,7 @@ class Aedat2Decoder final : public EventDecoder {
     dvs128_ = chip->dvs128_layout;
   }
 
-  void decode_record(std::uint32_t address, std::uint32_t time, EventBatch& out) {
+  void decode_record(std::uint32_t address, std::uint32_t time, EventBatch::Appender& out) {
     if (last_time_ >= time + (std::uint64_t{1} << 31)) wraps_ += 1;
     last_time_ = time;
     const Timestamp t = (wraps_ << 32) + time;

@@ -24,7 +24,8 @@ class DatDecoder final : public EventDecoder {
  public:
   explicit DatDecoder(std::string source) : source_(std::move(source)) {}
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     if (!header_.complete()) {
       if (!header_.take(chunk, source_)) return;
     }
@@ -67,7 +68,7 @@ class DatDecoder final : public EventDecoder {
     if (type_and_size_read_ == 2) records_.set_offset(offset + 1);
   }
 
-  void decode_record(std::uint32_t time, std::uint32_t data, EventBatch& out) {
+  void decode_record(std::uint32_t time, std::uint32_t data, EventBatch::Appender& out) {
     if (last_time_ >= time + std::uint64_t{kTimeHalfRange}) wraps_ += 1;
     last_time_ = time;
     out.push_back(wraps_ * kTimeRange + time, static_cast<std::uint16_t>(data & 0x3FFF),

@@ -18,7 +18,8 @@ class DvEventsDecoder final : public EventDecoder {
  public:
   explicit DvEventsDecoder(std::string source) : source_(std::move(source)) {}
 
-  void decode(std::span<const std::uint8_t> packet, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> packet, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     if (reinterpret_cast<std::uintptr_t>(packet.data()) % alignof(std::uint64_t) != 0) {
       // FlatBuffers reads its fields in place: a packet handed at an odd address is copied first.
       aligned_.resize((packet.size() + sizeof(std::uint64_t) - 1) / sizeof(std::uint64_t));

@@ -14,7 +14,8 @@ class DvsEventsDecoder final : public EventDecoder {
  public:
   explicit DvsEventsDecoder(std::string source) : source_(std::move(source)) {}
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     records_.feed(chunk, [&](const std::uint8_t* record, std::uint64_t) {
       const Timestamp t = Timestamp{load_le32(record + 4)} * 1'000'000 + load_le32(record + 8) / 1000;
       out.push_back(t, load_le16(record), load_le16(record + 2), record[12] != 0 ? std::int8_t{1} : std::int8_t{-1});

@@ -71,7 +71,8 @@ class EcdTextDecoder final : public EventDecoder {
  public:
   explicit EcdTextDecoder(std::string source) : source_(std::move(source)) {}
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     const char* const text = reinterpret_cast<const char*>(chunk.data());
     std::size_t pos = 0;
     if (!partial_.empty()) {
@@ -102,7 +103,8 @@ class EcdTextDecoder final : public EventDecoder {
     consumed_ += chunk.size();
   }
 
-  void finish(EventBatch& out) override {
+  void finish(EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     // A last line without '\n' is fine if it is complete; a cut one fails to parse and reports itself.
     if (partial_.empty()) return;
     parse_line(partial_, partial_offset_, out);
@@ -112,7 +114,7 @@ class EcdTextDecoder final : public EventDecoder {
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return std::nullopt; }
 
  private:
-  void parse_line(std::string_view line, std::uint64_t offset, EventBatch& out) {
+  void parse_line(std::string_view line, std::uint64_t offset, EventBatch::Appender& out) {
     ++line_number_;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     FieldCursor fields(line);

@@ -22,7 +22,8 @@ class EventStreamDecoder final : public EventDecoder {
  public:
   explicit EventStreamDecoder(std::string source) : source_(std::move(source)) {}
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     for (const std::uint8_t byte : chunk) {
       if (header_bytes_ < kHeaderBytes) {
         header_[header_bytes_++] = byte;
@@ -83,7 +84,7 @@ class EventStreamDecoder final : public EventDecoder {
     coordinates_ = 4;
   }
 
-  void emit(EventBatch& out) {
+  void emit(EventBatch::Appender& out) {
     if (threshold_crossing_) {
       ++counts_.skipped_words;
       return;

@@ -17,7 +17,8 @@ class Evt2Decoder final : public EventDecoder {
  public:
   Evt2Decoder(std::string source, RawFraming framing) : source_(std::move(source)), bare_words_(framing == RawFraming::BareWords) {}
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     if (!bare_words_ && !header_.complete()) {
       if (!header_.take(chunk, source_)) return;
       check_encoding();
@@ -45,7 +46,7 @@ class Evt2Decoder final : public EventDecoder {
     }
   }
 
-  void decode_word(std::uint32_t word, EventBatch& out) {
+  void decode_word(std::uint32_t word, EventBatch::Appender& out) {
     switch (word >> 28) {
       case kCdOff:
       case kCdOn:

@@ -26,7 +26,8 @@ class Evt21Decoder final : public EventDecoder {
  public:
   explicit Evt21Decoder(std::string source) : source_(std::move(source)) {}
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     if (!header_.complete()) {
       if (!header_.take(chunk, source_)) return;
       read_header();
@@ -64,7 +65,7 @@ class Evt21Decoder final : public EventDecoder {
     }
   }
 
-  void decode_word(std::uint64_t word, EventBatch& out) {
+  void decode_word(std::uint64_t word, EventBatch::Appender& out) {
     switch (word >> 60) {
       case kCdOff:
       case kCdOn: {

@@ -30,7 +30,8 @@ class LibcaerDecoder final : public EventDecoder {
     last_time_ = 0;
   }
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     records_.feed(chunk, [&](const std::uint8_t* record, std::uint64_t) {
       const std::uint32_t data = load_le32(record);
       const auto time = static_cast<std::int32_t>(load_le32(record + 4));
@@ -69,7 +70,8 @@ class LibcaerCompressedDecoder final : public EventDecoder {
     time_low_ = 0;
   }
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     words_.feed(chunk, [&](const std::uint8_t* bytes, std::uint64_t) {
       const std::uint16_t word = load_le16(bytes);
       const std::uint16_t payload = word & 0xFFF;

@@ -17,7 +17,8 @@ class MonoDecoder final : public EventDecoder {
     base_ns_left_ = time_base_ns % 1000 + (time_base_ns % 1000 < 0 ? 1000 : 0);
   }
 
-  void decode(std::span<const std::uint8_t> chunk, EventBatch& out) override {
+  void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
+    EventBatch::Appender out(batch);
     words_.feed(chunk, [&](const std::uint8_t* word, std::uint64_t) {
       const std::uint32_t high = load_le32(word + 4);
       out.push_back(base_us_ + static_cast<Timestamp>((base_ns_left_ + load_le32(word)) / 1000), static_cast<std::uint16_t>(high & 0xFFFF),

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
+#include <utility>
 
 #include "evldt/transport/channels.hpp"
 #include "evldt/transport/event_batcher.hpp"
@@ -112,7 +113,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
       }
       validator.filter(chunk);
       if (chunk.empty()) continue;
-      batcher.push(chunk);
+      batcher.push(std::move(chunk));  // chunk gets the storage of a consumed one back
       publish_ready(false);
       if (options_.progress_period_s > 0 &&
           Clock::now() - last_progress > std::chrono::duration<double>(options_.progress_period_s)) {

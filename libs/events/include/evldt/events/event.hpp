@@ -89,6 +89,60 @@ class EventBatch {
     p.resize(n);
   }
   [[nodiscard]] Event operator[](std::size_t i) const { return {t[i], x[i], y[i], p[i]}; }
+
+  class Appender;
+};
+
+/// Appends events to a batch faster than EventBatch::push_back, for decoders that emit event by
+/// event: the columns grow a block at a time and each event is four plain stores, with no
+/// per-column capacity check. While an appender is alive the columns may hold up to a block of
+/// zeroed events beyond the ones appended, so the batch must not be used otherwise; the
+/// destructor (also when an exception unwinds, e.g. a decoder's FormatError) trims the columns to
+/// the events appended, so the batch then holds exactly what push_back would have left.
+/// Keep it a local of the decoding function: its fields then stay in registers.
+class EventBatch::Appender {
+ public:
+  explicit Appender(EventBatch& batch) : batch_(batch), size_(batch.size()), columns_(columns_of(batch)) {}
+  ~Appender() { batch_.truncate(size_); }
+  Appender(const Appender&) = delete;
+  Appender& operator=(const Appender&) = delete;
+
+  void push_back(Timestamp time, std::uint16_t px, std::uint16_t py, std::int8_t polarity) {
+    if (size_ == columns_.room) [[unlikely]] columns_ = grow(batch_, size_);
+    columns_.t[size_] = time;
+    columns_.x[size_] = px;
+    columns_.y[size_] = py;
+    columns_.p[size_] = polarity;
+    ++size_;
+  }
+  void push_back(const Event& e) { push_back(e.t, e.x, e.y, e.p); }
+  /// Events in the batch so far (those it held before plus those appended).
+  [[nodiscard]] std::size_t size() const { return size_; }
+
+ private:
+  struct Columns {
+    Timestamp* t;
+    std::uint16_t* x;
+    std::uint16_t* y;
+    std::int8_t* p;
+    std::size_t room;  // events the columns hold now
+  };
+  // Small enough that the zeroing of a new block stays in L1 for the stores that overwrite it.
+  static constexpr std::size_t kBlock = 1024;
+
+  static Columns columns_of(EventBatch& batch) {
+    return {batch.t.data(), batch.x.data(), batch.y.data(), batch.p.data(), batch.size()};
+  }
+  // Static and by value, so that the appender's own address never escapes (the int8 stores could
+  // otherwise alias its fields, which would then be reloaded every event).
+  [[gnu::noinline]] static Columns grow(EventBatch& batch, std::size_t size) {
+    batch.truncate(size + kBlock);  // resize: geometric reallocation when the capacity runs out
+    return columns_of(batch);
+  }
+
+  EventBatch& batch_;
+  std::size_t size_;
+  Columns columns_;
 };
 
 }  // namespace evldt

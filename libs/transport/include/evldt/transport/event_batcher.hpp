@@ -4,6 +4,8 @@
 // datagram holds about 7000 events; larger messages are fragmented by LCM).
 
 #include <cstddef>
+#include <deque>
+#include <vector>
 
 #include "evldt/events/event.hpp"
 
@@ -16,19 +18,27 @@ class EventBatcher {
 
   /// Appends events (in time order) to the stream.
   void push(const EventBatch& events);
+  /// The same without copying them: the batcher keeps the columns of `events` and leaves it empty
+  /// (holding the storage of a batch already consumed, if there is one, to be filled again).
+  void push(EventBatch&& events);
   /// Moves the next complete batch into `out` (cleared first). A window is complete once an event
   /// of a later window has arrived or it holds max_events; `flush` also gives the incomplete tail.
   bool pop(EventBatch& out, bool flush = false);
   /// Events pushed but not popped.
-  [[nodiscard]] std::size_t pending() const { return buffer_.size() - head_; }
+  [[nodiscard]] std::size_t pending() const { return pending_; }
 
  private:
   [[nodiscard]] Timestamp window_end(Timestamp t) const;
+  /// An empty batch, with the storage of a consumed one if there is one.
+  EventBatch take_spare();
 
   Timestamp window_us_;
   std::size_t max_events_;
-  EventBatch buffer_;
+  // The stream in the batches it was pushed as (none empty), the first consumed up to head_.
+  std::deque<EventBatch> segments_;
   std::size_t head_ = 0;
+  std::size_t pending_ = 0;
+  std::vector<EventBatch> spares_;  // consumed segments, kept for their storage
 };
 
 }  // namespace evldt
