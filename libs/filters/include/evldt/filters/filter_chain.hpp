@@ -97,15 +97,16 @@ class FilterChain {
   std::optional<BackgroundActivityFilter> background_activity_;
   std::optional<RefractoryFilter> refractory_;
   std::optional<AntiFlickerFilter> anti_flicker_;
-  // The per-pixel state of every filter, in one allocation made and zeroed (nothing seen) once:
+  // The per-pixel state of every filter, in one mapping the kernel zeroes (nothing seen):
   // a 32-byte record per pixel (y * width + x) for hot-pixel, refractory and anti-flicker, then
   // background-activity's last-event times as a plane with a one-pixel border, so that its 3x3
   // neighbourhood lies on 3 rows of 4-byte cells (3 cache lines, not the 6 its times would span
   // as part of the records).
-  struct Free {
+  struct Unmap {
+    std::size_t bytes;
     void operator()(std::byte* memory) const;
   };
-  std::unique_ptr<std::byte, Free> table_;
+  std::unique_ptr<std::byte, Unmap> table_;
   std::size_t surface_offset_ = 0;  // bytes
   int width_;
   std::size_t surface_stride_ = 0;
