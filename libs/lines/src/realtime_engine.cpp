@@ -21,8 +21,8 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
     : config_(config),
       filters_(config.filters, config.lattice.sensor),
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
-      detect_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
-      track_view_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
+      detect_{ScarfLattice(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha)},
+      track_{ScarfLattice(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha)},
       lines_(lattice_.geometry(), config.track.reassociation),
       pool_(config.threads),
       detector_(lattice_.geometry(), config.score, &pool_),
@@ -37,11 +37,11 @@ void RealtimeEngine::start() {
     stopping_ = false;
   }
   detect_thread_ = std::thread([this] {
-    loop("evldt-detect", detect_view_, detect_wake_at_us_, detect_rounds_, config_.schedule.detect_period_us,
+    loop("evldt-detect", detect_, detect_rounds_, config_.schedule.detect_period_us,
          [this](const ScarfLattice& view, Timestamp now) { detector_.detect(view, lines_, now); });
   });
   track_thread_ = std::thread([this] {
-    loop("evldt-track", track_view_, track_wake_at_us_, track_rounds_, config_.schedule.track_period_us,
+    loop("evldt-track", track_, track_rounds_, config_.schedule.track_period_us,
          [this](const ScarfLattice& view, Timestamp now) { tracker_.track(view, lines_, now); });
   });
 }
@@ -79,12 +79,33 @@ void RealtimeEngine::process(const EventBatch& input) {
         events_stored_ += end - begin;
         latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
       }
-      if (end == n) note_input(input);
-      wake = latest_event_us_ >= std::min(detect_wake_at_us_, track_wake_at_us_);
+      if (end == n) {
+        note_input(input);
+        wake = hand_over_views();
+      }
+      wake = wake || latest_event_us_ >= std::min(detect_.wake_at_us, track_.wake_at_us);
     }
     if (wake) lattice_changed_.notify_all();
     begin = end;
   } while (begin < n);
+}
+
+bool RealtimeEngine::hand_over_views() {
+  bool handed = false;
+  for (LoopState* loop : {&detect_, &track_}) {
+    if (!loop->view_wanted) continue;
+    take_view(*loop);
+    handed = true;
+  }
+  return handed;
+}
+
+void RealtimeEngine::take_view(LoopState& loop) {
+  loop.view.copy_state_from(lattice_);
+  loop.view_seen = events_received_;
+  loop.view_us = latest_event_us_;
+  loop.view_wanted = false;
+  loop.view_ready = true;
 }
 
 void RealtimeEngine::shed(Timestamp until_us) {
@@ -99,9 +120,10 @@ void RealtimeEngine::note_input(const EventBatch& input) {
 }
 
 template <typename Round>
-void RealtimeEngine::loop(const char* thread_name, ScarfLattice& view, Timestamp& wake_at_us,
-                          std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round) {
+void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
+                          Round round) {
   name_this_thread(thread_name);
+  run_this_thread_below_storage();
   std::uint64_t seen = 0;
   Timestamp next_due = std::numeric_limits<Timestamp>::min();
   for (;;) {
@@ -113,28 +135,43 @@ void RealtimeEngine::loop(const char* thread_name, ScarfLattice& view, Timestamp
       // rounds in proportion to its event time. Only when the input pauses (a sparse or ending
       // stream) does a round run early, on whatever is new, so the last events never wait.
       const auto due = [&] { return stopping_ || (events_received_ != seen && latest_event_us_ >= next_due); };
-      wake_at_us = next_due;
+      state.wake_at_us = next_due;
+      bool paused = false;
       while (!due()) {
         if (events_received_ == seen) {
           // Idle (no CPU): woken by any input, which may start a pause that a round must follow.
-          wake_at_us = std::numeric_limits<Timestamp>::min();
+          state.wake_at_us = std::numeric_limits<Timestamp>::min();
           lattice_changed_.wait(lock, [&] { return stopping_ || events_received_ != seen; });
-          wake_at_us = next_due;
+          state.wake_at_us = next_due;
           continue;
         }
         const std::uint64_t received_before = events_received_;
-        if (!lattice_changed_.wait_for(lock, kInputPause, due) && events_received_ == received_before) break;
+        if (!lattice_changed_.wait_for(lock, kInputPause, due) && events_received_ == received_before) {
+          paused = true;
+          break;
+        }
       }
-      wake_at_us = std::numeric_limits<Timestamp>::max();  // busy with a round: nothing to wake
+      state.wake_at_us = std::numeric_limits<Timestamp>::max();  // busy with a round: nothing to wake
       if (stopping_) return;
-      view.copy_state_from(lattice_);
-      seen = events_received_;
-      now = latest_event_us_;
+      // The storing thread copies the lattice into the view when it has stored its current batch:
+      // this thread, which runs below storage's priority, then never holds the lattice's lock
+      // through a copy while preempted, which stalled storage for milliseconds. A paused input
+      // stores nothing more, so then the copy is made here.
+      if (!paused) {
+        state.view_wanted = true;
+        lattice_changed_.wait_for(lock, kInputPause, [&] { return stopping_ || state.view_ready; });
+        if (stopping_) return;
+      }
+      if (!state.view_ready) take_view(state);
+      state.view_ready = false;
+      state.view_wanted = false;
+      seen = state.view_seen;
+      now = state.view_us;
     }
     next_due = now + period_us;
     {
       std::lock_guard lock(lines_mutex_);
-      round(view, now);
+      round(state.view, now);
       lines_time_us_ = std::max(lines_time_us_, now);
       lines_version_.fetch_add(1, std::memory_order_release);
     }

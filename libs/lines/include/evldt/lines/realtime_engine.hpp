@@ -3,9 +3,11 @@
 // while detection and tracking loop on their own threads, each starting a round once a period of
 // event time has been stored since its last (or, when the input pauses, on whatever is new). So
 // the rounds follow the events: a stream replayed at a tenth of real time costs a tenth of the
-// rounds. Each loop works on its own copy of the lattice, updated under a short lock, so storage
-// never waits for a whole pass, and a round always starts from the newest state: rounds never
-// queue. The line state is shared by the two loops under a second lock.
+// rounds. Each loop works on its own copy of the lattice, which the storing thread brings up to date
+// between two batches when the loop asks for it, so storage never waits for a pass (nor for a
+// copy by a thread of lower priority), and a round always starts from the newest state: rounds
+// never queue. The loops run below storage's priority. The line state is shared by the two loops
+// under a second lock.
 
 #include <atomic>
 #include <chrono>
@@ -63,26 +65,38 @@ class RealtimeEngine {
   void set_first_line_id(std::uint64_t first);
 
  private:
+  /// A round loop's view of the lattice and its hand-over; guarded by lattice_mutex_ except the
+  /// view itself while the loop runs a round on it.
+  struct LoopState {
+    ScarfLattice view;
+    // Event time at which the loop, while it waits, wants to be woken: storage wakes the loops only
+    // when a round may be due, not at every batch.
+    Timestamp wake_at_us = 0;
+    bool view_wanted = false;  // the loop waits for storage to copy the lattice into its view
+    bool view_ready = false;   // storage did: the view holds the lattice as of view_seen / view_us
+    std::uint64_t view_seen = 0;
+    Timestamp view_us = 0;
+  };
+
   void note_input(const EventBatch& input);  // under lattice_mutex_
+  /// Copies the lattice into the view of each loop that wants one; whether any did. Under lattice_mutex_.
+  bool hand_over_views();
+  void take_view(LoopState& loop);  // under lattice_mutex_
   template <typename Round>
-  void loop(const char* thread_name, ScarfLattice& view, Timestamp& wake_at_us, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
-            Round round);
+  void loop(const char* thread_name, LoopState& state, std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round);
 
   PipelineConfig config_;
   mutable std::mutex filter_mutex_;           // the producer filters under it; counters() reads under it
   FilterChain filters_;                       // guarded by filter_mutex_
   EventBatch filtered_;                       // the producer's, reused
   ScarfLattice lattice_;                      // guarded by lattice_mutex_
-  ScarfLattice detect_view_, track_view_;     // each owned by its loop thread
   mutable std::mutex lattice_mutex_;
   std::condition_variable lattice_changed_;
   std::uint64_t events_stored_ = 0;           // guarded by lattice_mutex_
   std::uint64_t events_received_ = 0;         // stored or filtered; guarded by lattice_mutex_
   Timestamp latest_event_us_ = 0;             // guarded by lattice_mutex_
   bool stopping_ = false;                     // guarded by lattice_mutex_
-  // Event time at which each loop, while it waits, wants to be woken (guarded by lattice_mutex_):
-  // storage wakes the loops only when a round may be due, not at every batch.
-  Timestamp detect_wake_at_us_ = 0, track_wake_at_us_ = 0;
+  LoopState detect_, track_;
 
   mutable std::mutex lines_mutex_;
   LineMap lines_;                             // guarded by lines_mutex_
