@@ -90,7 +90,8 @@ std::byte* map_zeroed(std::size_t bytes) {
 // loop with no dispatch per event.
 template <filter_chain_detail::Kind... Ks>
 struct FilterChain::Pass {
-  static constexpr bool kRecords = ((Ks != Kind::BackgroundActivity) || ...);
+  static constexpr bool kRecords = ((Ks == Kind::Refractory || Ks == Kind::AntiFlicker) || ...);
+  static constexpr bool kCounts = ((Ks == Kind::HotPixel) || ...);
   static constexpr bool kSurface = ((Ks == Kind::BackgroundActivity) || ...);
 
   static void run(FilterChain& chain, const EventBatch& in, EventBatch& out) {
@@ -104,6 +105,7 @@ struct FilterChain::Pass {
     std::int8_t* const out_p = out.p.data();
     std::byte* const table = chain.table_.get();
     auto* const states = reinterpret_cast<PixelState*>(table);
+    auto* const counts = reinterpret_cast<std::uint32_t*>(table + chain.counts_offset_);
     auto* const surface = reinterpret_cast<std::uint32_t*>(table + chain.surface_offset_);
     const auto width = static_cast<std::size_t>(chain.width_);
     const std::size_t stride = chain.surface_stride_;
@@ -112,6 +114,7 @@ struct FilterChain::Pass {
       if (i + kPrefetchAhead < size) {
         const std::size_t ax = xs[i + kPrefetchAhead], ay = ys[i + kPrefetchAhead];
         if constexpr (kRecords) __builtin_prefetch(states + ay * width + ax, 1);
+        if constexpr (kCounts) __builtin_prefetch(counts + ay * width + ax, 1);
         if constexpr (kSurface) {
           const std::uint32_t* const row = surface + ay * stride + ax;  // the row above, from the left neighbour
           __builtin_prefetch(row);
@@ -127,7 +130,7 @@ struct FilterChain::Pass {
       const std::int8_t p = ps[i];
       [[maybe_unused]] const auto pixel = static_cast<std::uint32_t>(y * width + x);
       // In order, up to the first that drops the event.
-      if (!(test<Ks>(chain, t, x, y, p, pixel, states, surface, stride) && ...)) continue;
+      if (!(test<Ks>(chain, t, x, y, p, pixel, states, counts, surface, stride) && ...)) continue;
       out_t[kept] = t;  // kept <= i: safe in place
       out_x[kept] = x;
       out_y[kept] = y;
@@ -140,9 +143,9 @@ struct FilterChain::Pass {
 
   template <Kind K>
   static bool test(FilterChain& chain, Timestamp t, std::size_t x, std::size_t y, std::int8_t p, std::uint32_t pixel, PixelState* states,
-                   std::uint32_t* surface, std::size_t stride) {
+                   std::uint32_t* counts, std::uint32_t* surface, std::size_t stride) {
     if constexpr (K == Kind::HotPixel) {
-      return chain.hot_pixel_->pass(t, pixel, states);
+      return chain.hot_pixel_->pass(t, pixel, counts);
     } else if constexpr (K == Kind::AntiFlicker) {
       return chain.anti_flicker_->pass(t, states[pixel].flicker[p > 0 ? 1 : 0]);
     } else if constexpr (K == Kind::BackgroundActivity) {
@@ -191,11 +194,14 @@ FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) : width_
   }();
   pass_ = passes[code];
   const std::size_t pixels = static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height);
-  const std::size_t record_bytes = hot_pixel_ || refractory_ || anti_flicker_ ? pixels * sizeof(PixelState) : 0;
+  const std::size_t record_bytes = refractory_ || anti_flicker_ ? pixels * sizeof(PixelState) : 0;
+  const std::size_t count_bytes = hot_pixel_ ? pixels * sizeof(std::uint32_t) : 0;
   const std::size_t surface_bytes = background_activity_ ? BackgroundActivityFilter::surface_size(sensor) * sizeof(std::uint32_t) : 0;
-  if (record_bytes + surface_bytes > 0) {
-    table_ = std::unique_ptr<std::byte, Unmap>(map_zeroed(record_bytes + surface_bytes), Unmap{mapped_size(record_bytes + surface_bytes)});
-    surface_offset_ = record_bytes;
+  const std::size_t table_bytes = record_bytes + count_bytes + surface_bytes;
+  if (table_bytes > 0) {
+    table_ = std::unique_ptr<std::byte, Unmap>(map_zeroed(table_bytes), Unmap{mapped_size(table_bytes)});
+    counts_offset_ = record_bytes;
+    surface_offset_ = record_bytes + count_bytes;
     surface_stride_ = BackgroundActivityFilter::surface_stride(sensor);
   }
 }

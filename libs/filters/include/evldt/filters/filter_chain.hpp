@@ -97,17 +97,18 @@ class FilterChain {
   std::optional<BackgroundActivityFilter> background_activity_;
   std::optional<RefractoryFilter> refractory_;
   std::optional<AntiFlickerFilter> anti_flicker_;
-  // The per-pixel state of every filter, in one mapping the kernel zeroes (nothing seen):
-  // a 32-byte record per pixel (y * width + x) for hot-pixel, refractory and anti-flicker, then
-  // background-activity's last-event times as a plane with a one-pixel border, so that its 3x3
-  // neighbourhood lies on 3 rows of 4-byte cells (3 cache lines, not the 6 its times would span
-  // as part of the records).
+  // The per-pixel state of every filter, in one mapping the kernel zeroes (nothing seen), each part
+  // only where its filter is in the chain: a 32-byte record per pixel (y * width + x) for refractory
+  // and anti-flicker; hot-pixel's counts as a plane of 4-byte cells, which its judging scans whole
+  // every window; background-activity's last-event times as a plane with a one-pixel border, so
+  // that its 3x3 neighbourhood lies on 3 rows of 4-byte cells (3 cache lines, not the 6 its times
+  // would span as part of the records).
   struct Unmap {
     std::size_t bytes;
     void operator()(std::byte* memory) const;
   };
   std::unique_ptr<std::byte, Unmap> table_;
-  std::size_t surface_offset_ = 0;  // bytes
+  std::size_t counts_offset_ = 0, surface_offset_ = 0;  // bytes
   int width_;
   std::size_t surface_stride_ = 0;
   std::uint64_t events_in_ = 0, passed_ = 0;

@@ -34,13 +34,12 @@ struct FlickerBurst {
   std::uint8_t flags;        // AntiFlickerFilter::kSeen, kFlickerBurst
 };
 
-/// What hot-pixel, refractory and anti-flicker keep about one pixel: 32 bytes, two to a cache line,
-/// so an event's tests touch one line (background-activity's times, which it reads for 8
-/// neighbours, are a plane of their own: see filter_chain.hpp). Trivial: the chain's table of them
-/// is zeroed memory, every field zero, which every filter reads as nothing seen; filters not in
-/// the chain leave their fields at zero.
+/// What refractory and anti-flicker keep about one pixel: 32 bytes (4 of them padding), two to a
+/// cache line, so an event's tests touch one line (hot-pixel's counts and background-activity's
+/// times, which are scanned whole or read for 8 neighbours, are planes of their own: see
+/// filter_chain.hpp). Trivial: the chain's table of them is zeroed memory, every field zero, which
+/// every filter reads as nothing seen; filters not in the chain leave their fields at zero.
 struct alignas(32) PixelState {
-  std::uint32_t hot_pixel;   // HotPixelFilter: the pixel's events in the window, | kMasked
   std::uint32_t refractory;  // RefractoryFilter: its last passed event's time, on the filter's clock
   FlickerBurst flicker[2];   // AntiFlickerFilter: [0] OFF, [1] ON
 };
@@ -154,34 +153,34 @@ class HotPixelFilter {
  public:
   HotPixelFilter(SensorSize sensor, const HotPixelParams& params);
 
-  /// The test of an event at time t at pixel `pixel` (y * width + x) of `states` (the chain's
-  /// table): counts the event, after judging the window it ends.
-  [[gnu::always_inline]] bool pass(Timestamp t, std::uint32_t pixel, PixelState* states) {
-    if (t >= window_end_) [[unlikely]] end_window(t, states);
-    std::uint32_t& count = states[pixel].hot_pixel;
-    if ((count & ~kMasked) == 0) touched_[touched_count_++] = pixel;  // room for every pixel
+  /// The test of an event at time t at pixel `pixel` (y * width + x) of `counts` (the chain's plane
+  /// of counts, one per pixel): counts the event, after judging the window it ends.
+  [[gnu::always_inline]] bool pass(Timestamp t, std::uint32_t pixel, std::uint32_t* counts) {
+    if (t >= window_end_) [[unlikely]] end_window(t, counts);
+    std::uint32_t& count = counts[pixel];
     ++count;  // the count stays far below kMasked: a window of a few seconds at any real rate
     if ((count & kMasked) == 0) return true;
     ++dropped_;
     return false;
   }
   [[nodiscard]] std::uint64_t dropped() const { return dropped_; }
-  /// The masked pixels (y * width + x), in the order they were masked.
+  /// The masked pixels (y * width + x): those still masked in the order they were masked, then
+  /// those masked at the last judging in pixel order.
   [[nodiscard]] std::span<const std::uint32_t> masked_pixels() const { return masked_list_; }
 
  private:
   static constexpr std::uint32_t kMasked = 0x80000000u;  // in a count: the pixel is masked
   /// The first event starts the first window; a later one at or past its end judges it (masks the
-  /// pixels that were hot in it, releases those that cooled) and starts the next.
-  void end_window(Timestamp t, PixelState* states);
+  /// pixels that were hot in it, releases those that cooled) and starts the next. One pass down the
+  /// plane of counts, which is a ninth of the records' size: a list of the pixels touched, judged
+  /// in the order they came, read the table all over and stalled storage for 10 ms at 1280x720.
+  void end_window(Timestamp t, std::uint32_t* counts);
 
   SensorSize sensor_;
   HotPixelParams params_;
   std::uint32_t min_count_, release_count_;
   Timestamp window_end_;  // the lowest time until the first event
   bool started_ = false;
-  std::unique_ptr<std::uint32_t[]> touched_;  // [0, touched_count_): pixels with a count, to judge and reset
-  std::size_t touched_count_ = 0;
   std::vector<std::uint32_t> masked_list_;
   std::vector<std::uint32_t> still_masked_;  // scratch of end_window
   std::uint64_t dropped_ = 0;
