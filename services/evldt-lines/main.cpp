@@ -7,6 +7,7 @@
 
 #include "evldt/app/lcm_options.hpp"
 #include "evldt/app/pipeline_options.hpp"
+#include "evldt/lines/thread_name.hpp"
 #include "evldt/nodes/lines_node.hpp"
 #include "evldt/transport/channels.hpp"
 
@@ -51,6 +52,11 @@ int main(int argc, char** argv) {
     options.configure = [&](SensorSize sensor) { return pipeline_options.resolve(sensor); };
     if (options.sensor) (void)pipeline_options.resolve(*options.sensor);  // a bad value fails now, not at the first batch
     const auto& stop = stop_on_signals();
+    // This thread receives and stores events, with LCM's reading thread, which it starts: above the
+    // rounds, which must take what the cores have left, not delay storage.
+    if (!raise_this_thread_above_rounds()) {
+      spdlog::info("storage runs at the rounds' priority: raising it needs CAP_SYS_NICE (README, real time)");
+    }
     const auto lcm = lcm_options.connect();
     LinesNode node(*lcm, options, process_epoch_us());
     announce_ready("evldt-lines", fmt::format("listening on {} ({}), publishing {} at {} Hz", events_channel(options.camera),

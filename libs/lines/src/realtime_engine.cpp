@@ -123,7 +123,7 @@ template <typename Round>
 void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
                           Round round) {
   name_this_thread(thread_name);
-  run_this_thread_below_storage();
+  run_this_thread_as_round();
   std::uint64_t seen = 0;
   Timestamp next_due = std::numeric_limits<Timestamp>::min();
   for (;;) {
@@ -154,7 +154,7 @@ void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic
       state.wake_at_us = std::numeric_limits<Timestamp>::max();  // busy with a round: nothing to wake
       if (stopping_) return;
       // The storing thread copies the lattice into the view when it has stored its current batch:
-      // this thread, which runs below storage's priority, then never holds the lattice's lock
+      // this thread, which runs at a lower priority than storage where the service could raise storage's, then never holds the lattice's lock
       // through a copy while preempted, which stalled storage for milliseconds. A paused input
       // stores nothing more, so then the copy is made here.
       if (!paused) {

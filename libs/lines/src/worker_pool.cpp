@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "evldt/lines/thread_name.hpp"
+
 namespace evldt {
 
 WorkerPool::WorkerPool(int threads) {
@@ -41,6 +43,7 @@ void WorkerPool::run_erased(Erased function, void* context) {
 }
 
 void WorkerPool::work(int worker) {
+  run_this_thread_as_round();  // a pool started by the storing thread would share its priority
   std::uint64_t seen = 0;
   for (;;) {
     Erased function = nullptr;

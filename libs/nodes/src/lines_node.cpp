@@ -124,7 +124,7 @@ void LinesNode::run(const std::atomic<bool>& stop) {
 
 void LinesNode::publish_loop(const std::atomic<bool>& stop) {
   name_this_thread("evldt-publish");
-  run_this_thread_below_storage();
+  run_this_thread_as_round();
   // A list goes out once a round has changed the lines, at most one per publish period; an
   // unchanged one again after a second (a heartbeat, so a subscriber sees the service live).
   constexpr auto kHeartbeat = std::chrono::seconds(1);

@@ -6,7 +6,7 @@
 // rounds. Each loop works on its own copy of the lattice, which the storing thread brings up to date
 // between two batches when the loop asks for it, so storage never waits for a pass (nor for a
 // copy by a thread of lower priority), and a round always starts from the newest state: rounds
-// never queue. The loops run below storage's priority. The line state is shared by the two loops
+// never queue. The loops run at the process's priority (evldt-lines raises storage's above it). The line state is shared by the two loops
 // under a second lock.
 
 #include <atomic>

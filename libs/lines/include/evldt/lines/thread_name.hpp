@@ -1,6 +1,6 @@
 #pragma once
 // Names the calling thread (up to 15 characters show), so `top -H` and `perf report --sort comm`
-// tell a service's threads apart; and lowers a thread's CPU priority below storage's.
+// tell a service's threads apart; and sets a thread's CPU priority, storage's above the rounds'.
 
 #include <pthread.h>
 #include <sys/resource.h>
@@ -10,13 +10,30 @@ namespace evldt {
 
 inline void name_this_thread(const char* name) { pthread_setname_np(pthread_self(), name); }
 
-/// Nice value of the rounds and the publisher: when the cores are short, the thread that receives
-/// and stores events gets them first (a late batch is shed; a late round only covers more event
-/// time). 10 gives a nice-0 thread about nine tenths of a core it shares with one of these.
-constexpr int kBelowStorageNice = 10;
+/// How much higher than the rounds and the publisher the thread that receives and stores events
+/// runs, in nice steps: when the cores are short it gets them first (a late batch is shed; a late
+/// round only covers more event time). 10 steps give it about nine tenths of a core it shares with
+/// one of them.
+constexpr int kStoragePriorityBoost = 10;
 
-/// Lowers the calling thread's priority (Linux: nice is per thread). Never fails loudly: a higher
-/// nice value is always allowed, and without it the service only loses the preference.
-inline void run_this_thread_below_storage() { setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kBelowStorageNice); }
+/// The nice value the process started with (the first call reads the calling thread's: make it
+/// before any thread changes its own).
+inline int process_nice() {
+  static const int nice = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid()));
+  return nice;
+}
+
+/// Raises the calling thread above the process's nice value by kStoragePriorityBoost (Linux: nice
+/// is per thread, and threads it starts inherit it). Needs CAP_SYS_NICE (root) or an RLIMIT_NICE
+/// that allows it; false where it was not allowed (the thread then keeps its priority).
+inline bool raise_this_thread_above_rounds() {
+  const int base = process_nice();
+  return setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), base - kStoragePriorityBoost) == 0;
+}
+
+/// Puts the calling thread back at the process's nice value: the rounds, the publisher and the
+/// round workers, which a raised thread starts, do not inherit its priority. Lowering is always
+/// allowed.
+inline void run_this_thread_as_round() { setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), process_nice()); }
 
 }  // namespace evldt
