@@ -12,23 +12,33 @@ source_dir=$2
 source "$source_dir/tests/services/test_lib.sh"
 url="udpm://239.255.76.67:7714?ttl=0"
 budget_ms=20
+# The unhurried run's budget: a sanitizer build runs the service several times slower (ThreadSanitizer
+# 5-15x), beside other tests, so 20 ms is not within its means there; it must still shed nothing
+# systematically (a wrong clock estimate would shed whatever the budget).
+idle_budget_ms=$budget_ms
+grep -q '^EVLDT_SANITIZE:STRING=.' "$build/CMakeCache.txt" 2>/dev/null && idle_budget_ms=100
 
 run_camera() {  # run_camera OUT: boxes-6dof in real time, 3 s
   "$camera" --lcm-url "$url" --scene boxes-6dof --duration-s 3 -q >"$1" 2>&1
 }
 
 # --- 1. within means ----------------------------------------------------------------------------
-"$lines" --lcm-url "$url" --log-period-s 0 --max-latency-ms "$budget_ms" >"$work/idle.out" 2>"$work/idle.err" &
+"$lines" --lcm-url "$url" --log-period-s 0 --max-latency-ms "$idle_budget_ms" >"$work/idle.out" 2>"$work/idle.err" &
 lines_pid=$!
 wait_ready "$work/idle.err" evldt-lines
 run_camera "$work/camera1.out" &
 camera_pid=$!
-sleep 1  # the engine's threads start with the first batch
-threads=$(ps -L -o tid=,ni=,comm= -p "$lines_pid")
+# The engine's threads start with the first batch. Each thread's id, name and nice value from its
+# stat line (one awk for all, so polling disturbs little; names have no spaces here); the
+# receiving thread is the main one.
+thread_nice() { awk '{ gsub(/[()]/, "", $2); print $1, $2, $19 }' /proc/"$lines_pid"/task/*/stat; }
+tracking_started() { thread_nice | grep -q ' evldt-track '; }
+wait_until "evldt-lines's tracking thread" tracking_started
+threads=$(thread_nice)
 echo "$threads"
 if [[ $(id -u) == 0 ]]; then
   check "the receiving thread runs 10 nice steps above the tracking loop" \
-    awk -v pid="$lines_pid" '$1 == pid { r = $2 } $3 == "evldt-track" { t = $2 } END { exit !(r != "" && t != "" && t - r == 10) }' <<<"$threads"
+    awk -v pid="$lines_pid" '$1 == pid { r = $3 } $2 == "evldt-track" { t = $3 } END { exit !(r != "" && t != "" && t - r == 10) }' <<<"$threads"
 else
   echo "skipped the priority check: not root, so evldt-lines may not raise its receiving thread"
 fi
@@ -38,7 +48,7 @@ sleep 0.5  # the last batches and lists
 kill -INT "$lines_pid"
 wait "$lines_pid"
 cat "$work/idle.out"
-check "an unhurried run sheds nothing" grep -qP "shed +0 batches, 0 events" "$work/idle.out"
+check "an unhurried run sheds nothing (budget $idle_budget_ms ms)" grep -qP "shed +0 batches, 0 events" "$work/idle.out"
 check "... and loses nothing" grep -qP "batches +$batches received, 0 lost" "$work/idle.out"
 
 # --- 2. slowed on purpose -----------------------------------------------------------------------

@@ -593,6 +593,22 @@ TEST(LatencyBudget, ShedsWhatQueuedPastTheBudgetWhateverTheSendersClock) {
   EXPECT_THROW(LatencyBudget(-1), std::invalid_argument);
 }
 
+TEST(LatencyBudget, WhatQueuedWhileTheConsumerStartedIsNotLate) {
+  LatencyBudget budget(20);
+  std::int64_t now = 1'000'000;
+  const std::int64_t offset = 2'000'000;  // the sender's clock is ahead of ours
+  EXPECT_FALSE(budget.late(now + offset - 400, now));  // the first batch: the consumer starts on it
+  // It takes 60 ms to start; 60 batches published meanwhile (one a millisecond) arrive together.
+  now += 60'000;
+  budget.ready_at(now);
+  for (std::int64_t k = 1; k <= 60; ++k) EXPECT_FALSE(budget.late(now + offset - 60'000 - 400 + k * 1000, now)) << k;
+  EXPECT_NEAR(static_cast<double>(budget.last_queueing_us()), 0, 1);  // the last of them queued briefly
+  // After the start a stall is judged as ever.
+  now += 30'000;
+  EXPECT_TRUE(budget.late(now + offset - 400 - 25'000, now));
+  EXPECT_FALSE(budget.late(now + offset - 400, now));
+}
+
 TEST(LatencyBudget, AClockStepIsForgottenWithinTwoWindows) {
   LatencyBudget budget(20, /*window_us=*/1'000'000);
   std::int64_t now = 0;

@@ -24,7 +24,14 @@ bool LatencyBudget::late(std::int64_t publish_utime, std::int64_t now_utime) {
   }
   current_min_ = std::min(current_min_, delay);
   last_queueing_us_ = delay - std::min(current_min_, previous_min_);
+  if (exempt_ && publish_utime <= exempt_until_publish_) return false;
   return budget_us_ > 0 && last_queueing_us_ > budget_us_;
+}
+
+void LatencyBudget::ready_at(std::int64_t now_utime) {
+  if (!started_) return;  // nothing arrived yet: nothing queued
+  exempt_ = true;
+  exempt_until_publish_ = now_utime - std::min(current_min_, previous_min_);
 }
 
 }  // namespace evldt

@@ -23,6 +23,12 @@ class LatencyBudget {
   /// queued longer than the budget and should be shed. Every arrival refines the estimate.
   bool late(std::int64_t publish_utime, std::int64_t now_utime);
 
+  /// The consumer was not ready until `now_utime` (ours): its store was being built. Batches
+  /// published before then (as judged by the quickest delivery seen) are never late: they queued
+  /// behind a one-off start, not behind a consumer that cannot keep up, and an empty store is better
+  /// filled with them than left empty. Their queueing is still measured.
+  void ready_at(std::int64_t now_utime);
+
   [[nodiscard]] double max_latency_ms() const { return static_cast<double>(budget_us_) * 1e-3; }
   /// How long the last batch queued (its delay beyond the quickest delivery), in microseconds.
   [[nodiscard]] std::int64_t last_queueing_us() const { return last_queueing_us_; }
@@ -35,6 +41,8 @@ class LatencyBudget {
   std::int64_t window_start_ = 0;
   std::int64_t current_min_ = 0, previous_min_ = 0;
   std::int64_t last_queueing_us_ = 0;
+  bool exempt_ = false;
+  std::int64_t exempt_until_publish_ = 0;  // sender's clock: batches published up to then are not late
 };
 
 }  // namespace evldt
