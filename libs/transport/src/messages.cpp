@@ -1,5 +1,6 @@
 #include "evldt/transport/messages.hpp"
 
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -140,6 +141,10 @@ std::uint16_t get_be16(const std::uint8_t* in) {
 constexpr std::int64_t kMaxTimeBase = std::int64_t{1} << 62;
 
 }  // namespace
+
+// The column loops below byte-swap in registers and store host order: big-endian on the wire only
+// on a little-endian host (x86-64, AArch64 as Linux runs it).
+static_assert(std::endian::native == std::endian::little, "the event batch encoder assumes a little-endian host");
 
 void encode_event_batch(const event_batch_t& header, const EventBatch& events, std::vector<std::uint8_t>& out) {
   const std::size_t n = events.size();
