@@ -58,10 +58,10 @@ namespace {
 // this each event waits for memory (measured: twice the throughput at 1280x720).
 constexpr std::size_t kPrefetchAhead = 16;
 
-// The table is mapped from the kernel in whole huge pages, zeroed by it: a memset of the 33 MB of
-// 1280x720 took 40 ms, the kernel's zeroing about a third of that. It is faulted in here, before the
-// first batch (a service does not count a batch late for queueing behind its start), not by the
-// first batches, which then took 70 ms and queued the next ones past the latency budget.
+// The table is mapped from the kernel in whole huge pages, zeroed by it, and faulted in here,
+// before the first batch (a service does not count a batch late for queueing behind its start),
+// not by the first batches, which at 1280x720 then took 70 ms and queued the next ones past the
+// latency budget.
 // Transparent huge pages are asked for where the kernel offers them: events land all over a table
 // far larger than what the TLB covers with 4 KiB pages (measured: 15% more throughput at 640x480
 // and 1280x720).

@@ -58,6 +58,7 @@ void RealtimeEngine::stop() {
 
 void RealtimeEngine::process(const EventBatch& input) {
   if (input.empty()) return;
+  storing_.store(true, std::memory_order_relaxed);
   const EventBatch* stored = &input;
   if (!filters_.empty()) {
     std::lock_guard lock(filter_mutex_);
@@ -88,6 +89,7 @@ void RealtimeEngine::process(const EventBatch& input) {
     if (wake) lattice_changed_.notify_all();
     begin = end;
   } while (begin < n);
+  storing_.store(false, std::memory_order_relaxed);
 }
 
 bool RealtimeEngine::hand_over_views() {
@@ -153,11 +155,11 @@ void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic
       }
       state.wake_at_us = std::numeric_limits<Timestamp>::max();  // busy with a round: nothing to wake
       if (stopping_) return;
-      // The storing thread copies the lattice into the view when it has stored its current batch:
-      // this thread, which runs at a lower priority than storage where the service could raise storage's, then never holds the lattice's lock
-      // through a copy while preempted, which stalled storage for milliseconds. A paused input
-      // stores nothing more, so then the copy is made here.
-      if (!paused) {
+      // While a batch is being stored, the storing thread copies the lattice into the view when it
+      // has stored it: this thread, which may run below storage's priority, then never holds the
+      // lattice's lock through a copy while preempted, which stalled storage for milliseconds.
+      // Between batches, or when the input paused, the copy is made here at once.
+      if (!paused && storing_.load(std::memory_order_relaxed)) {
         state.view_wanted = true;
         lattice_changed_.wait_for(lock, kInputPause, [&] { return stopping_ || state.view_ready; });
         if (stopping_) return;

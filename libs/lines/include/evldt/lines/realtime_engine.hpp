@@ -96,6 +96,7 @@ class RealtimeEngine {
   std::uint64_t events_received_ = 0;         // stored or filtered; guarded by lattice_mutex_
   Timestamp latest_event_us_ = 0;             // guarded by lattice_mutex_
   bool stopping_ = false;                     // guarded by lattice_mutex_
+  std::atomic<bool> storing_{false};          // process() is running: a loop lets it copy the views
   LoopState detect_, track_;
 
   mutable std::mutex lines_mutex_;
