@@ -11,6 +11,10 @@ BackgroundActivityFilter::BackgroundActivityFilter(SensorSize sensor, Timestamp 
       min_uncorrelated_(min_noise_hz * static_cast<double>(kJudgeUs) * 1e-6 * static_cast<double>(sensor.width) *
                         static_cast<double>(sensor.height)),
       judge_end_(std::numeric_limits<Timestamp>::min()) {
+  check_params(window_us, min_noise_hz);
+}
+
+void BackgroundActivityFilter::check_params(Timestamp window_us, double min_noise_hz) {
   if (window_us <= 0 || window_us > 1'000'000'000) throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
   if (!(min_noise_hz >= 0)) throw std::invalid_argument("the background-activity noise level must not be negative");
 }

@@ -42,11 +42,8 @@ void check_filter_config(const FilterConfig& config) {
     if (std::ranges::find(filter_names(), *name) == filter_names().end()) throw std::invalid_argument("unknown filter '" + *name + "'");
     if (std::find(config.chain.begin(), name, *name) != name) throw std::invalid_argument("filter '" + *name + "' given twice");
   }
-  if (config.background_window_us <= 0 || config.background_window_us > 1'000'000'000) {
-    throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
-  }
-  if (!(config.background_min_noise_hz >= 0)) throw std::invalid_argument("the background-activity noise level must not be negative");
-  if (config.refractory_us <= 0 || config.refractory_us > 1'000'000'000) throw std::invalid_argument("the refractory period must be in 1 us .. 1000 s");
+  BackgroundActivityFilter::check_params(config.background_window_us, config.background_min_noise_hz);
+  RefractoryFilter::check_params(config.refractory_us);
   check_params(config.hot_pixel);
   check_params(config.anti_flicker);
 }

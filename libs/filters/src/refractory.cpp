@@ -9,6 +9,10 @@ RefractoryFilter::RefractoryFilter(SensorSize sensor, Timestamp period_us)
     : pixels_(static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height)),
       period_us_(static_cast<std::int32_t>(period_us)),
       next_sweep_(std::numeric_limits<Timestamp>::min()) {
+  check_params(period_us);
+}
+
+void RefractoryFilter::check_params(Timestamp period_us) {
   if (period_us <= 0 || period_us > 1'000'000'000) throw std::invalid_argument("the refractory period must be in 1 us .. 1000 s");
 }
 

@@ -50,7 +50,10 @@ class BackgroundActivityFilter {
   /// Drops uncorrelated events only while they come at `min_noise_hz` per pixel or more (judged over
   /// each 200 ms of event time, applied to the next): a clean sensor's uncorrelated events are mostly
   /// the sparse edges of slow or faint motion, which the lattice needs (0: always drop them).
+  /// Throws std::invalid_argument for a window not in 1 us .. 1000 s or a negative noise level.
   BackgroundActivityFilter(SensorSize sensor, Timestamp window_us, double min_noise_hz);
+  /// The parameter checks of the constructor, for a configuration checked before any filter is built.
+  static void check_params(Timestamp window_us, double min_noise_hz);
 
   /// Row stride of the surface of last-event times the filter reads: the sensor with a one-pixel
   /// border, so neighbours need no bounds checks.
@@ -104,6 +107,8 @@ class RefractoryFilter {
  public:
   /// Throws std::invalid_argument for a period not in 1 us .. 1000 s.
   RefractoryFilter(SensorSize sensor, Timestamp period_us);
+  /// The parameter check of the constructor, for a configuration checked before any filter is built.
+  static void check_params(Timestamp period_us);
 
   /// The test of an event at time t at pixel `pixel` (y * width + x) of `states` (the chain's table).
   [[gnu::always_inline]] bool pass(Timestamp t, std::uint32_t pixel, PixelState* states) {
