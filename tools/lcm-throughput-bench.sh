@@ -81,13 +81,14 @@ for speed in $speeds; do
     pids+=("$logger_pid")
     sleep 0.3
   fi
+  lines_cpu_before=$(cpu_seconds "$lines_pid")  # its start-up (building nothing yet) is not the stream's cost
   "$camera" "$recording" --lcm-url "$url" --speed "$speed" --loop --quiet --log-level warn >"$work/camera.out" 2>"$work/camera.err" &
   camera_pid=$!
   pids+=("$camera_pid")
   started=$(date +%s.%N)
   sleep "$seconds"
   camera_cpu=$(cpu_seconds "$camera_pid")
-  lines_cpu=$(cpu_seconds "$lines_pid")
+  lines_cpu=$(awk -v a="$lines_cpu_before" -v b="$(cpu_seconds "$lines_pid")" 'BEGIN { print b - a }')
   wall=$(awk -v s="$started" -v e="$(date +%s.%N)" 'BEGIN { print e - s }')
   kill -INT "$camera_pid"
   wait "$camera_pid" || true

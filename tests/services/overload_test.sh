@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Bounded latency with the real processes over UDP multicast on loopback (ttl=0):
 #  1. A run well within the machine's means sheds nothing; its receiving thread runs 10 nice steps
-#     above its rounds (where the test may raise it: as root).
+#     above its rounds (where the test may raise it: as root); waiting, before the stream and after
+#     it, costs no CPU.
 #  2. A consumer slowed on purpose (evldt-lines stopped with SIGSTOP for 300 ms, twice) sheds the
 #     batches that queued past its latency budget, counts them apart from losses (summary and
 #     statistics messages), loses none, and keeps the median latency of what it stored within the budget.
@@ -26,6 +27,18 @@ run_camera() {  # run_camera OUT: boxes-6dof in real time, 3 s
 "$lines" --lcm-url "$url" --log-period-s 0 --max-latency-ms "$idle_budget_ms" >"$work/idle.out" 2>"$work/idle.err" &
 lines_pid=$!
 wait_ready "$work/idle.err" evldt-lines
+# Waiting costs no CPU: a busy loop costs a core. Before the first batch (no engine yet) here, and
+# after the stream below.
+cpu_ticks() { awk '{ print $14 + $15 }' "/proc/$1/stat"; }
+mostly_idle() {  # mostly_idle PID: the process used under a fifth of a core over 2 s
+  local before after
+  before=$(cpu_ticks "$1")
+  sleep 2
+  after=$(cpu_ticks "$1")
+  echo "  CPU over 2 s: $(((after - before) * 100 / ($(getconf CLK_TCK) * 2)))% of a core"
+  ((after - before < $(getconf CLK_TCK) * 2 / 5))
+}
+check "evldt-lines waiting for its first batch is idle" mostly_idle "$lines_pid"
 run_camera "$work/camera1.out" &
 camera_pid=$!
 # The engine's threads start with the first batch. Each thread's id, name and nice value from its
@@ -45,6 +58,7 @@ fi
 wait "$camera_pid"
 batches=$(field "$work/camera1.out" 'batches')
 sleep 0.5  # the last batches and lists
+check "evldt-lines after its stream ended is idle" mostly_idle "$lines_pid"
 kill -INT "$lines_pid"
 wait "$lines_pid"
 cat "$work/idle.out"

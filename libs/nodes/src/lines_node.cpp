@@ -161,9 +161,12 @@ void LinesNode::publish_loop(const std::atomic<bool>& stop) {
                    last_latency_.p99_ms);
     }
     now = Clock::now();
-    const auto wake = std::min({last_stats + stats_period, last_list + kHeartbeat, now + kLongestWait});
     const auto engine = this->engine();
-    if (now < next_publish || !engine) {
+    const auto next_stats = std::min(last_stats + stats_period, now + kLongestWait);
+    const auto wake = std::min(next_stats, last_list + kHeartbeat);
+    if (!engine) {
+      std::this_thread::sleep_until(next_stats);  // nothing received yet: no list (nor heartbeat) to publish
+    } else if (now < next_publish) {
       std::this_thread::sleep_until(std::min(next_publish, wake));
     } else {
       engine->wait_for_round(published_engine_ == engine ? published_version_ : 0, wake);
