@@ -56,6 +56,11 @@ trap cleanup EXIT
 
 "$sim" --scene "$scene" --out-dir "$work/rec" --format evt3 --quiet >/dev/null
 recording=$work/rec/events.raw
+# The sensor size, given to evldt-lines as a deployment gives its camera's (config/WxH.toml), so
+# that it builds its lattice and filters at start, not while the first batches queue.
+geometry=$(head -c 512 "$recording" | grep -aoP '^% geometry \K[0-9]+x[0-9]+' || true)
+[[ -n $geometry ]] || { echo "lcm-throughput-bench.sh: no sensor geometry in $recording" >&2; exit 1; }
+sensor_args=(--width "${geometry%x*}" --height "${geometry#*x}")
 ticks=$(getconf CLK_TCK)
 cpu_seconds() {  # user + system CPU seconds of a live process
   awk -v t="$ticks" '{ print ($14 + $15) / t }' "/proc/$1/stat"
@@ -64,13 +69,13 @@ field() {  # field FILE REGEX: the first number after REGEX
   { grep -oP "$2\s*\K[0-9.]+" "$1" || true; } | head -1
 }
 
-printf 'scene %s, %s s per speed, segment lists at %s Hz, %s, evldt-lines %s\n' "$scene" "$seconds" "$publish_hz" "$url" \
-  "${lines_args[*]:-(defaults)}"
+printf 'scene %s, %s s per speed, segment lists at %s Hz, %s, evldt-lines %s %s\n' "$scene" "$seconds" "$publish_hz" "$url" \
+  "${sensor_args[*]}" "${lines_args[*]:-(defaults otherwise)}"
 printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %7s\n' speed "Mev/s" "batches lost" "shed (events %)" "camera CPU" "lines CPU" threads "B/event" "latency ms" "F@1%"
 rows=()
 best=0
 for speed in $speeds; do
-  "$lines" --lcm-url "$url" --publish-hz "$publish_hz" --log-period-s 0 ${lines_args[@]+"${lines_args[@]}"} >"$work/lines.out" 2>"$work/lines.err" &
+  "$lines" --lcm-url "$url" --publish-hz "$publish_hz" --log-period-s 0 "${sensor_args[@]}" ${lines_args[@]+"${lines_args[@]}"} >"$work/lines.out" 2>"$work/lines.err" &
   lines_pid=$!
   pids+=("$lines_pid")
   for _ in $(seq 1200); do grep -q "evldt-lines ready:" "$work/lines.err" && break; sleep 0.05; done

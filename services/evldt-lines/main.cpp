@@ -15,7 +15,8 @@ int main(int argc, char** argv) {
   using namespace evldt;
   CLI::App app{"evldt-lines: detect and track line segments in real time from EVENTS_<CAMERA> (LCM).\n"
                "Publishes evldt.segment_list_t on LINES_<CAMERA> at --publish-hz and evldt.stats_t on EVLDT_STATS\n"
-               "once a second. The sensor size comes from the first batch unless --width/--height or --config set it.\n"
+               "once a second. The sensor size comes from the first batch unless --width/--height or --config set it (then the\n"
+               "lattice and filters are built at start, and the first batches do not queue behind them).\n"
                "Runs until SIGINT/SIGTERM, then prints a summary."};
   LcmOptions lcm_options;
   PipelineOptions pipeline_options;

@@ -307,6 +307,39 @@ TEST(Nodes, GarbageAndForeignMessagesAreCountedNotFatal) {
   EXPECT_EQ(totals.receiver.sequence.received, 1u);
 }
 
+// A configured sensor size: the engine is built at start (no batch queues behind it) and serves
+// the first batch; nothing is published before a batch has come, and it is not counted as a restart.
+TEST(Nodes, ConfiguredSensorEngineServesTheFirstBatch) {
+  lcm::LCM lcm("memq://");
+  ListCollector collector(lcm, "LINES_CAM0");
+  LinesNodeOptions options = quiet_lines();
+  options.sensor = SensorSize{240, 180};
+  constexpr std::int64_t kEpoch = 3'000'000;
+  RunningLines lines(lcm, kEpoch, options);
+  std::this_thread::sleep_for(1200ms);  // longer than the heartbeat (1 s) of a service that has lines
+  EXPECT_TRUE(collector.lists().empty());
+  const std::atomic<bool> never{false};
+  const CameraSummary sent = CameraNode(lcm, fast_camera(), 1).run(scene_source("boxes-6dof", 200'000), never);
+  ASSERT_TRUE(wait_for([&] {
+    const auto lists = collector.lists();
+    return !lists.empty() && lists.back().newest_batch_seq == static_cast<std::int64_t>(sent.batches - 1);
+  }));
+  lines.stop();
+  const LinesNodeTotals totals = lines.node.totals();
+  EXPECT_EQ(totals.engine_restarts, 0u);
+  EXPECT_EQ(totals.receiver.sequence.lost, 0u);
+  EXPECT_EQ(totals.events_received, sent.events_published);
+  EXPECT_EQ(totals.events_stored, totals.filtered.passed);
+  EXPECT_GT(totals.lines_created, 0u);
+  std::size_t segments = 0;
+  for (const auto& list : collector.lists()) {
+    EXPECT_EQ(list.width, 240);
+    for (const auto& entry : list.segments) EXPECT_GE(static_cast<std::uint64_t>(entry.id), static_cast<std::uint64_t>(kEpoch));
+    segments += list.segments.size();
+  }
+  EXPECT_GT(segments, 0u);
+}
+
 TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   lcm::LCM lcm("memq://");
   ListCollector collector(lcm, "LINES_CAM0");

@@ -47,6 +47,10 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
   // LCM queues 30 messages per subscription by default and drops beyond; a stall of a few ms at
   // kHz batch rates would lose batches.
   subscription_->setQueueCapacity(kEventQueueCapacity);
+  // Built now when the sensor size is known: building takes tens of ms at 1280x720 (a first touch of
+  // 40 MB; up to 200 ms on a virtual machine's fresh memory), and the batches that queue behind it
+  // meanwhile would be late, or lost once the socket's buffer fills.
+  if (options_.sensor) prebuilt_ = std::make_shared<RealtimeEngine>(options_.configure(*options_.sensor));
 }
 
 LinesNode::~LinesNode() {
@@ -98,13 +102,16 @@ void LinesNode::start_engine() {
     spdlog::info("first batch on {}: {}x{} sensor from '{}'", events_channel(options_.camera), sensor.width,
                  sensor.height, receiver_.message().source);
   }
-  auto engine = std::make_shared<RealtimeEngine>(options_.configure(*receiver_.sensor()));
+  // The engine built at start for a configured sensor serves the first batch; a restart needs a fresh one.
+  auto engine = prebuilt_ ? std::move(prebuilt_) : std::make_shared<RealtimeEngine>(options_.configure(*receiver_.sensor()));
+  prebuilt_.reset();
   spdlog::info("engine: b={}, rounds on {} thread(s)", engine->config().lattice.block_size, engine->config().threads);
   engine->set_first_line_id(next_line_id_ + retired.lines_created);
   engine->start();
   std::lock_guard lock(mutex_);
   if (engine_) ++engine_restarts_;
   engine_ = std::move(engine);
+  engine_started_.notify_all();
   latency_ = LatencyTracker();
   next_line_id_ += retired.lines_created;
   retired_.events += retired.events;
@@ -164,8 +171,9 @@ void LinesNode::publish_loop(const std::atomic<bool>& stop) {
     const auto engine = this->engine();
     const auto next_stats = std::min(last_stats + stats_period, now + kLongestWait);
     const auto wake = std::min(next_stats, last_list + kHeartbeat);
-    if (!engine) {
-      std::this_thread::sleep_until(next_stats);  // nothing received yet: no list (nor heartbeat) to publish
+    if (!engine) {  // nothing received yet: no list (nor heartbeat) to publish before an engine starts
+      std::unique_lock lock(mutex_);
+      engine_started_.wait_until(lock, next_stats, [&] { return engine_ != nullptr; });
     } else if (now < next_publish) {
       std::this_thread::sleep_until(std::min(next_publish, wake));
     } else {

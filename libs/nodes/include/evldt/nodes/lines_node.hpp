@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
@@ -28,7 +29,7 @@ inline constexpr double kDefaultMaxLatencyMs = 20;
 
 struct LinesNodeOptions {
   std::string camera = "cam0";
-  std::optional<SensorSize> sensor;  ///< unset: adopt the first valid batch's
+  std::optional<SensorSize> sensor;  ///< unset: adopt the first valid batch's (set: the engine is built at start)
   std::function<PipelineConfig(SensorSize)> configure = default_config_for;
   Timestamp time_slack_us = 1000;
   double publish_hz = 100;  ///< at most this many segment lists a second: one after each round, when rounds are faster
@@ -91,10 +92,12 @@ class LinesNode {
   EventBatchReceiver receiver_;
   LatencyBudget budget_;
   EventBatch batch_;
+  std::shared_ptr<RealtimeEngine> prebuilt_;  ///< built at start for a configured sensor, for the first batch
 
   mutable std::mutex mutex_;  // guards the members below (the receive thread alone writes them)
   std::uint64_t next_line_id_;
   std::shared_ptr<RealtimeEngine> engine_;
+  std::condition_variable engine_started_;  ///< wakes the publisher, which waits for the first engine
   ReceiverCounts receiver_counts_;
   LatencyTracker latency_;
   std::uint64_t engine_restarts_ = 0;
