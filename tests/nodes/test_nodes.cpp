@@ -5,7 +5,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <map>
+#include <sched.h>
 #include <lcm/lcm-cpp.hpp>
 #include <mutex>
 #include <set>
@@ -309,6 +312,17 @@ TEST(Nodes, GarbageAndForeignMessagesAreCountedNotFatal) {
 
 // A configured sensor size: the engine is built at start (no batch queues behind it) and serves
 // the first batch; nothing is published before a batch has come, and it is not counted as a restart.
+/// The scheduling policy of each of this process's threads, by thread name.
+std::multimap<std::string, int> thread_policies() {
+  std::multimap<std::string, int> policies;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::string name;
+    std::getline(std::ifstream(task.path() / "comm"), name);
+    policies.emplace(name, sched_getscheduler(std::stoi(task.path().filename().string())));
+  }
+  return policies;
+}
+
 TEST(Nodes, ConfiguredSensorEngineServesTheFirstBatch) {
   lcm::LCM lcm("memq://");
   ListCollector collector(lcm, "LINES_CAM0");
@@ -318,6 +332,13 @@ TEST(Nodes, ConfiguredSensorEngineServesTheFirstBatch) {
   RunningLines lines(lcm, kEpoch, options);
   std::this_thread::sleep_for(1200ms);  // longer than the heartbeat (1 s) of a service that has lines
   EXPECT_TRUE(collector.lists().empty());
+  // The rounds were started with the engine and wait; they and the publisher are batch work, which
+  // never preempts storage when it wakes.
+  const auto policies = thread_policies();
+  for (const char* name : {"evldt-detect", "evldt-track", "evldt-publish"}) {
+    ASSERT_EQ(policies.count(name), 1u) << name;
+    EXPECT_EQ(policies.find(name)->second, SCHED_BATCH) << name;
+  }
   const std::atomic<bool> never{false};
   const CameraSummary sent = CameraNode(lcm, fast_camera(), 1).run(scene_source("boxes-6dof", 200'000), never);
   ASSERT_TRUE(wait_for([&] {

@@ -11,6 +11,8 @@ namespace evldt {
 namespace {
 // Longest run of events stored under one lock hold, so the loops' snapshots never wait long.
 constexpr std::size_t kInsertChunk = 8192;
+// Batches up to this size (an LCM datagram holds 7000 events) filter without growing a buffer.
+constexpr std::size_t kPreparedBatch = std::size_t{1} << 16;
 // Input that stops for this long (wall time) is a pause: the rounds then run on what is new
 // without waiting for a period of event time. Longer than a live camera's or a slow replay's gap
 // between batches, short enough that the last events of a stream are answered promptly.
@@ -26,7 +28,9 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
       lines_(lattice_.geometry(), config.track.reassociation),
       pool_(config.threads),
       detector_(lattice_.geometry(), config.score, &pool_),
-      tracker_(lattice_.geometry(), config.score, config.track, &pool_) {}
+      tracker_(lattice_.geometry(), config.score, config.track, &pool_) {
+  filtered_.reserve_touched(kPreparedBatch);
+}
 
 RealtimeEngine::~RealtimeEngine() { stop(); }
 

@@ -36,7 +36,7 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
       budget_(options_.max_latency_ms),
       next_line_id_(static_cast<std::uint64_t>(epoch_us)),
       next_whole_id_(static_cast<std::uint64_t>(epoch_us)) {
-  batch_.reserve(1 << 16);
+  batch_.reserve_touched(1 << 16);
   if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100) ||
       !(options_.whole_lines_hz > 0 && options_.whole_lines_hz <= 10000)) {
     throw std::invalid_argument("publish and whole-line rates must be in (0, 10000] Hz and the stats rate in (0, 100] Hz");
@@ -50,7 +50,14 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
   // Built now when the sensor size is known: building takes tens of ms at 1280x720 (a first touch of
   // 40 MB; up to 200 ms on a virtual machine's fresh memory), and the batches that queue behind it
   // meanwhile would be late, or lost once the socket's buffer fills.
-  if (options_.sensor) prebuilt_ = std::make_shared<RealtimeEngine>(options_.configure(*options_.sensor));
+  if (options_.sensor) prebuilt_ = make_engine(*options_.sensor, next_line_id_);
+}
+
+std::shared_ptr<RealtimeEngine> LinesNode::make_engine(SensorSize sensor, std::uint64_t first_line_id) const {
+  auto engine = std::make_shared<RealtimeEngine>(options_.configure(sensor));
+  engine->set_first_line_id(first_line_id);
+  engine->start();  // its loops wait for events, using no CPU (starting them takes milliseconds)
+  return engine;
 }
 
 LinesNode::~LinesNode() {
@@ -103,16 +110,14 @@ void LinesNode::start_engine() {
                  sensor.height, receiver_.message().source);
   }
   // The engine built at start for a configured sensor serves the first batch; a restart needs a fresh one.
-  auto engine = prebuilt_ ? std::move(prebuilt_) : std::make_shared<RealtimeEngine>(options_.configure(*receiver_.sensor()));
+  auto engine = prebuilt_ ? std::move(prebuilt_) : make_engine(*receiver_.sensor(), next_line_id_ + retired.lines_created);
   prebuilt_.reset();
   spdlog::info("engine: b={}, rounds on {} thread(s)", engine->config().lattice.block_size, engine->config().threads);
-  engine->set_first_line_id(next_line_id_ + retired.lines_created);
-  engine->start();
   std::lock_guard lock(mutex_);
   if (engine_) ++engine_restarts_;
   engine_ = std::move(engine);
   engine_started_.notify_all();
-  latency_ = LatencyTracker();
+  if (engine_restarts_ > 0) latency_ = LatencyTracker();  // latency since the camera's (re)start
   next_line_id_ += retired.lines_created;
   retired_.events += retired.events;
   retired_.events_received += retired.events_received;

@@ -3,6 +3,7 @@
 // tell a service's threads apart; and sets a thread's CPU priority, storage's above the rounds'.
 
 #include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -31,9 +32,16 @@ inline bool raise_this_thread_above_rounds() {
   return setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), base - kStoragePriorityBoost) == 0;
 }
 
-/// Puts the calling thread back at the process's nice value: the rounds, the publisher and the
-/// round workers, which a raised thread starts, do not inherit its priority. Lowering is always
-/// allowed.
-inline void run_this_thread_as_round() { setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), process_nice()); }
+/// Puts the calling thread back at the process's nice value (the rounds, the publisher and the
+/// round workers, which a raised thread starts, do not inherit its priority) and marks it as batch
+/// work (SCHED_BATCH): waking, it never preempts a running thread. As a normal thread, a round that
+/// woke after a sleep could take the storing thread's core for a few milliseconds (the sleeper's
+/// credit of the fair scheduler) whatever their nice values; storage then fell behind by that much
+/// at every wake-up. Both calls are always allowed.
+inline void run_this_thread_as_round() {
+  const sched_param batch{};
+  sched_setscheduler(0, SCHED_BATCH, &batch);
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), process_nice());
+}
 
 }  // namespace evldt

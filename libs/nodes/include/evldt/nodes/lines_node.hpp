@@ -73,6 +73,8 @@ class LinesNode {
  private:
   void on_events(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void start_engine();
+  /// A started engine for `sensor` whose lines are numbered from `first_line_id`.
+  [[nodiscard]] std::shared_ptr<RealtimeEngine> make_engine(SensorSize sensor, std::uint64_t first_line_id) const;
   void publish_loop(const std::atomic<bool>& stop);
   /// Publishes the lines if a round changed them since the last list, or if `heartbeat` is set;
   /// true if it sent a list.
@@ -92,7 +94,7 @@ class LinesNode {
   EventBatchReceiver receiver_;
   LatencyBudget budget_;
   EventBatch batch_;
-  std::shared_ptr<RealtimeEngine> prebuilt_;  ///< built at start for a configured sensor, for the first batch
+  std::shared_ptr<RealtimeEngine> prebuilt_;  ///< built and started at start for a configured sensor, for the first batch
 
   mutable std::mutex mutex_;  // guards the members below (the receive thread alone writes them)
   std::uint64_t next_line_id_;
