@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "evldt/events/event_decoder.hpp"
-#include "evldt/events/event_reader.hpp"
+#include "evldt/events/event_stream_reader.hpp"
 #include "evldt/events/event_writer.hpp"
 #include "support/temp_dir.hpp"
 
@@ -95,9 +95,9 @@ struct ReadResult {
   bool ended_after_error = false;
 };
 
-/// Reads the whole file through EventFileReader, stopping at the first FormatError.
+/// Reads the whole file through EventStreamReader, stopping at the first FormatError.
 ReadResult read_file(const fs::path& path, std::optional<EventFormat> format, std::size_t chunk_bytes) {
-  EventFileReader reader(path, format, chunk_bytes);
+  EventStreamReader reader(path, format, chunk_bytes);
   ReadResult result;
   EventBatch batch;
   try {
@@ -106,7 +106,7 @@ ReadResult read_file(const fs::path& path, std::optional<EventFormat> format, st
       const auto events = events_of(batch);
       result.events.insert(result.events.end(), events.begin(), events.end());
     }
-    EXPECT_EQ(reader.bytes_read(), reader.file_size());
+    EXPECT_EQ(reader.bytes_read(), reader.total_bytes());
   } catch (const FormatError& error) {
     result.error = error;
     result.ended_after_error = !reader.read(batch);
@@ -178,6 +178,21 @@ TEST(EventBatchAppender, AnExceptionLeavesTheEventsAppendedBeforeIt) {
   EXPECT_EQ(batch.t.back(), 1499);
 }
 
+TEST(EventBatch, ReserveTouchedEmptiesItWithRoomThatDoesNotMove) {
+  EventBatch batch;
+  batch.push_back(7, 1, 2, -1);
+  batch.reserve_touched(4096);
+  EXPECT_TRUE(batch.empty());
+  const auto* const t = batch.t.data();
+  const auto* const x = batch.x.data();
+  const auto* const p = batch.p.data();
+  for (int i = 0; i < 4096; ++i) batch.push_back(i, 3, 4, 1);
+  EXPECT_EQ(batch.t.data(), t);  // no reallocation: the room was there
+  EXPECT_EQ(batch.x.data(), x);
+  EXPECT_EQ(batch.p.data(), p);
+  EXPECT_EQ(batch.size(), 4096u);
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Names
 
@@ -212,7 +227,7 @@ TEST_P(RoundTrip, ReadsBackExactlyWhatWasWrittenWhateverTheChunkSize) {
 
   for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, kOneMiB}) {
     SCOPED_TRACE("chunk " + std::to_string(chunk));
-    EventFileReader reader(path, std::nullopt, chunk);  // the format is guessed from the name (and header)
+    EventStreamReader reader(path, std::nullopt, chunk);  // the format is guessed from the name (and header)
     EXPECT_EQ(reader.format(), format);
     if (format == EventFormat::EcdText) {
       EXPECT_FALSE(reader.geometry());
@@ -259,7 +274,7 @@ TEST(RoundTripEdges, EmptyRecordingHasHeaderOnly) {
     EXPECT_FALSE(result.error);
     EXPECT_TRUE(result.events.empty());
     if (format != EventFormat::EcdText) {
-      EXPECT_EQ(EventFileReader(path, format).geometry(), kSensor);
+      EXPECT_EQ(EventStreamReader(path, format).geometry(), kSensor);
     }
   }
 }
@@ -301,16 +316,16 @@ TEST(Header, RawFileFormatIsTakenFromTheHeaderOrRefused) {
   auto bytes = bytes_of("% format EVT2;height=480;width=640\n% end\n");
   append_le32(bytes, 0x10000000u | (3u << 11) | 4u);  // CD_ON at x=3 y=4, t=0
   write_bytes(path, bytes);
-  EXPECT_EQ(EventFileReader(path).format(), EventFormat::Evt2);
+  EXPECT_EQ(EventStreamReader(path).format(), EventFormat::Evt2);
   EXPECT_EQ(read_file(path, std::nullopt, kOneMiB).events, (std::vector<Event>{{0, 3, 4, 1}}));
 
   write_bytes(path, bytes_of("% camera something\n% end\n"));
-  const FormatError no_version = expect_format_error([&] { EventFileReader reader(path); });
+  const FormatError no_version = expect_format_error([&] { EventStreamReader reader(path); });
   EXPECT_EQ(no_version.byte_offset(), 0u);
   EXPECT_NE(std::string(no_version.what()).find(path.string()), std::string::npos);
 
   write_bytes(path, bytes_of("% format EVT4;height=480;width=640\n% end\n"));
-  EXPECT_THROW(EventFileReader reader(path), FormatError);
+  EXPECT_THROW(EventStreamReader reader(path), FormatError);
 }
 
 TEST(Header, DecoderRefusesDataTheHeaderSaysIsAnotherEncoding) {
@@ -539,7 +554,7 @@ TEST(RawQuirks, Evt3PaddingAndReservedWordsAreSkippedAndCountedInAnyChunking) {
   write_bytes(path, bytes);
   for (const std::size_t chunk : {std::size_t{1}, std::size_t{3}, kOneMiB}) {
     SCOPED_TRACE(chunk);
-    EventFileReader reader(path, std::nullopt, chunk);
+    EventStreamReader reader(path, std::nullopt, chunk);
     EventBatch batch, all;
     while (reader.read(batch)) {
       for (std::size_t i = 0; i < batch.size(); ++i) all.push_back(batch[i]);
@@ -620,7 +635,7 @@ TEST(Aedat, Aedat31PolarityPacketsWithTheirOverflowOtherPacketsSkipped) {
     const ReadResult result = read_file(path, std::nullopt, chunk);  // recognised by its first line
     EXPECT_FALSE(result.error);
     EXPECT_EQ(result.events, expected);
-    EventFileReader reader(path, std::nullopt, chunk);
+    EventStreamReader reader(path, std::nullopt, chunk);
     EXPECT_EQ(reader.format(), EventFormat::Aedat31);
     EXPECT_EQ(reader.geometry(), (SensorSize{346, 260}));
     EventBatch batch;
@@ -650,7 +665,7 @@ TEST(Aedat, Aedat2AddressesOfDavisAndDvs128ChipsMirroredToATopLeftOrigin) {
   record(davis, 1u << 10, 0xFFFFFFF2u);                          // an external input: a trigger
   record(davis, 0u << 22 | 239u << 12, 0x10u);                   // OFF at raw (239, 0), after the 2^32 us wrap
   write_bytes(path, davis);
-  EventFileReader reader(path, std::nullopt, 5);
+  EventStreamReader reader(path, std::nullopt, 5);
   EXPECT_EQ(reader.format(), EventFormat::Aedat2);
   EXPECT_EQ(reader.geometry(), (SensorSize{240, 180}));
   EXPECT_EQ(read_file(path, std::nullopt, 5).events,
@@ -665,7 +680,7 @@ TEST(Aedat, Aedat2AddressesOfDavisAndDvs128ChipsMirroredToATopLeftOrigin) {
   record(dvs128, 0x8000u, 8);                 // an external event
   record(dvs128, 127u << 8 | 0u << 1 | 1u, 9);
   write_bytes(path, dvs128);
-  EXPECT_EQ(EventFileReader(path).geometry(), (SensorSize{128, 128}));
+  EXPECT_EQ(EventStreamReader(path).geometry(), (SensorSize{128, 128}));
   EXPECT_EQ(read_file(path, std::nullopt, kOneMiB).events, (std::vector<Event>{{7, 124, 123, 1}, {9, 127, 0, -1}}));
 }
 
@@ -693,8 +708,8 @@ TEST(EventStream, DvsAndAtisEventsWithTheirTimeDeltas) {
   dvs.push_back(0 << 1 | 0);      // same time, OFF
   coordinates(dvs, 303, 239);
   write_bytes(path, dvs);
-  EXPECT_EQ(EventFileReader(path, std::nullopt, 3).format(), EventFormat::EventStream);
-  EXPECT_EQ(EventFileReader(path, std::nullopt, 3).geometry(), (SensorSize{304, 240}));
+  EXPECT_EQ(EventStreamReader(path, std::nullopt, 3).format(), EventFormat::EventStream);
+  EXPECT_EQ(EventStreamReader(path, std::nullopt, 3).geometry(), (SensorSize{304, 240}));
   for (const std::size_t chunk : {std::size_t{1}, std::size_t{5}, kOneMiB}) {
     EXPECT_EQ(read_file(path, std::nullopt, chunk).events, (std::vector<Event>{{137, 3, 239, 1}, {137, 303, 0, -1}}));
   }
@@ -768,7 +783,7 @@ TEST(Reader, MissingFileIsARuntimeErrorNamingThePath) {
   TempDir dir;
   const fs::path path = dir.file("does-not-exist.raw");
   try {
-    EventFileReader reader(path);
+    EventStreamReader reader(path);
     FAIL() << "opened a missing file";
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
@@ -779,7 +794,7 @@ TEST(Reader, UnknownExtensionNeedsAnExplicitFormat) {
   TempDir dir;
   const fs::path path = dir.file("events.bin");
   write_file(path, EventFormat::Dat, {{1, 2, 3, 1}});
-  EXPECT_THROW(EventFileReader reader(path), std::runtime_error);
+  EXPECT_THROW(EventStreamReader reader(path), std::runtime_error);
   EXPECT_EQ(read_file(path, EventFormat::Dat, kOneMiB).events, (std::vector<Event>{{1, 2, 3, 1}}));
 }
 

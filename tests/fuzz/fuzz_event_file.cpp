@@ -1,4 +1,4 @@
-// Fuzz target for EventFileReader: the first input byte picks the file name's extension (.txt, .dat,
+// Fuzz target for EventStreamReader: the first input byte picks the file name's extension (.txt, .dat,
 // .raw: the format guessed as evldt-offline guesses it, .raw from its header) and the chunk size;
 // the rest is the file. Checks: only std::runtime_error (FormatError or a refused file) escapes,
 // the reader stops for good after an error, and it never reads more bytes than the file has.
@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "evldt/events/event_reader.hpp"
+#include "evldt/events/event_stream_reader.hpp"
 #include "fuzz_support.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -18,7 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const evldt::fuzz::TempFile file({data + 1, size - 1}, extension);
   using evldt::fuzz::require;
   try {
-    evldt::EventFileReader reader(file.path(), {}, chunk_bytes);
+    evldt::EventStreamReader reader(file.path(), {}, chunk_bytes);
     evldt::EventBatch batch;
     evldt::fuzz::read_to_the_end(reader, batch);
     require(reader.bytes_read() <= size - 1, "read more bytes than the file has");

@@ -9,7 +9,7 @@
 
 #include "evldt/containers/hdf5_events.hpp"
 #include "evldt/containers/packet_source.hpp"
-#include "evldt/events/event_reader.hpp"
+#include "evldt/events/event_stream_reader.hpp"
 #include <spdlog/spdlog.h>
 #include "evldt/transport/lcm_log.hpp"
 
@@ -25,11 +25,11 @@ class RecordingSource final : public EventSource {
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return reader_.geometry(); }
   [[nodiscard]] DecodeCounts decode_counts() const override { return reader_.counts(); }
   [[nodiscard]] double progress() const override {
-    return static_cast<double>(reader_.bytes_read()) / static_cast<double>(std::max<std::uint64_t>(1, reader_.file_size()));
+    return static_cast<double>(reader_.bytes_read()) / static_cast<double>(std::max<std::uint64_t>(1, reader_.total_bytes()));
   }
 
  private:
-  EventFileReader reader_;
+  EventStreamReader reader_;
 };
 
 class ContainerSource final : public EventSource {

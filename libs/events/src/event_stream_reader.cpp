@@ -1,4 +1,4 @@
-#include "evldt/events/event_reader.hpp"
+#include "evldt/events/event_stream_reader.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -40,61 +40,59 @@ std::string lowercase(std::string text) {
 
 }  // namespace
 
-EventFileReader::EventFileReader(const std::filesystem::path& path, std::optional<EventFormat> format, std::size_t chunk_bytes)
-    : source_(path.string()), file_(path, std::ios::binary), chunk_(std::max<std::size_t>(chunk_bytes, 1)) {
-  if (!file_) throw std::runtime_error("cannot open event file '" + source_ + "'");
-  std::error_code size_error;
-  file_size_ = std::filesystem::file_size(path, size_error);
-  if (size_error) file_size_ = 0;
+EventStreamReader::EventStreamReader(const std::filesystem::path& path, std::optional<EventFormat> format, std::size_t chunk_bytes)
+    : EventStreamReader(std::make_unique<FileBytes>(path), format, path.extension().string(), chunk_bytes) {}
 
+EventStreamReader::EventStreamReader(std::unique_ptr<ByteSource> bytes, std::optional<EventFormat> format,
+                                     std::string_view extension, std::size_t chunk_bytes)
+    : bytes_(std::move(bytes)), chunk_(std::max<std::size_t>(chunk_bytes, 1)) {
+  const std::string& source = bytes_->name();
+  // The first bytes, kept: a stream cannot be read twice.
+  constexpr std::size_t kMagicBytes = 20;  // also where an Event Stream header's sensor size ends
+  std::vector<std::uint8_t> header_bytes;
+  const auto read_more = [&] {
+    const std::size_t size = read_chunk();
+    header_bytes.insert(header_bytes.end(), chunk_.begin(), chunk_.begin() + static_cast<std::ptrdiff_t>(size));
+    return size;
+  };
+  while (header_bytes.size() < kMagicBytes && read_more() > 0) {
+  }
   // AEDAT and Event Stream files say what they are in their first bytes, whatever their name.
   if (!format) {
-    std::string start(12, '\0');
-    file_.read(start.data(), static_cast<std::streamsize>(start.size()));
+    const std::string_view start(reinterpret_cast<const char*>(header_bytes.data()), header_bytes.size());
     if (start.starts_with("#!AER-DAT2")) format = EventFormat::Aedat2;
     if (start.starts_with("#!AER-DAT3")) format = EventFormat::Aedat31;
     if (start.starts_with("Event Stream")) format = EventFormat::EventStream;
-    file_.clear();
-    file_.seekg(0);
   }
-  const std::string extension = lowercase(path.extension().string());
-  const bool format_from_header = !format && extension == ".raw";
+  const std::string lower_extension = lowercase(std::string(extension));
+  const bool format_from_header = !format && (lower_extension == ".raw" || lower_extension.empty());
   if (!format && !format_from_header) {
-    if (extension == ".txt") {
+    if (lower_extension == ".txt") {
       format = EventFormat::EcdText;
-    } else if (extension == ".dat") {
+    } else if (lower_extension == ".dat") {
       format = EventFormat::Dat;
     } else {
-      throw std::runtime_error("cannot tell the format of '" + source_ + "' from its name: give it (ecd, evt2, evt3, evt21, dat)");
+      throw std::runtime_error("cannot tell the format of '" + source + "' from its name: give it (ecd, evt2, evt3, evt21, dat)");
     }
   }
 
   // Read the text header now so that format() and geometry() are known before the first read().
-  std::vector<std::uint8_t> header_bytes;
   if (format != EventFormat::EcdText && format != EventFormat::EventStream) {
     detail::TextHeader header(format == EventFormat::Aedat2 || format == EventFormat::Aedat31 ? '#' : '%');
-    while (!header.complete()) {
-      const std::size_t size = read_chunk();
-      if (size == 0) break;
-      header.consume({chunk_.data(), size}, source_);
-      header_bytes.insert(header_bytes.end(), chunk_.begin(), chunk_.begin() + static_cast<std::ptrdiff_t>(size));
+    std::size_t consumed = 0;
+    for (;;) {
+      consumed += header.consume(std::span(header_bytes).subspan(consumed), source);
+      if (header.complete() || read_more() == 0) break;
     }
     if (format_from_header) {
       const auto encoding = header.encoding();
-      if (!encoding) throw FormatError(source_, 0, "no '% evt' or '% format' header line tells the EVT version; give the format");
+      if (!encoding) throw FormatError(source, 0, "no '% evt' or '% format' header line tells the EVT version; give the format");
       format = detail::raw_format_from_encoding(*encoding);
-      if (!format) throw FormatError(source_, 0, "the header names the encoding " + *encoding + ", not EVT2, EVT21 or EVT3");
-    }
-  } else if (format == EventFormat::EventStream) {
-    constexpr std::size_t kEventStreamHeaderBytes = 20;  // its sensor size ends there
-    while (header_bytes.size() < kEventStreamHeaderBytes) {
-      const std::size_t size = read_chunk();
-      if (size == 0) break;
-      header_bytes.insert(header_bytes.end(), chunk_.begin(), chunk_.begin() + static_cast<std::ptrdiff_t>(size));
+      if (!format) throw FormatError(source, 0, "the header names the encoding " + *encoding + ", not EVT2, EVT21 or EVT3");
     }
   }
   format_ = *format;
-  decoder_ = make_decoder(format_, source_);
+  decoder_ = make_decoder(format_, source);
   // The chunk(s) read with the header may hold events (and faults): keep them for read().
   try {
     decoder_->decode(header_bytes, pending_);
@@ -103,7 +101,7 @@ EventFileReader::EventFileReader(const std::filesystem::path& path, std::optiona
   }
 }
 
-bool EventFileReader::read(EventBatch& out) {
+bool EventStreamReader::read(EventBatch& out) {
   out.clear();
   if (!pending_.empty()) {
     std::swap(out, pending_);
@@ -130,10 +128,8 @@ bool EventFileReader::read(EventBatch& out) {
   return false;
 }
 
-std::size_t EventFileReader::read_chunk() {
-  file_.read(reinterpret_cast<char*>(chunk_.data()), static_cast<std::streamsize>(chunk_.size()));
-  const auto size = static_cast<std::size_t>(file_.gcount());
-  if (file_.bad()) throw std::runtime_error("cannot read event file '" + source_ + "'");
+std::size_t EventStreamReader::read_chunk() {
+  const std::size_t size = bytes_->read(chunk_);
   bytes_read_ += size;
   return size;
 }
