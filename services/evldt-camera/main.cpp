@@ -15,7 +15,9 @@ int main(int argc, char** argv) {
   CLI::App app{"evldt-camera: publish camera events over LCM on EVENTS_<CAMERA> (evldt.event_batch_t), and its\n"
                "statistics (evldt.stats_t, once a second: events, drops, words the decoder skipped) on EVLDT_STATS.\n"
                "Sources: a recording in any format evldt reads (see input), a built-in --scene, or\n"
-               "--from-video FILE|WEBCAM_INDEX by frame differencing. Prints progress and a summary.\n"
+               "--from-video FILE|WEBCAM_INDEX by frame differencing; live, as a camera records: '-' (standard\n"
+               "input), tcp://HOST:PORT, or --follow FILE while a recorder writes it (events go out as they come,\n"
+               "unpaced). Prints progress and a summary.\n"
                "Exit status: 0 done or stopped by SIGINT/SIGTERM, 1 bad usage or setup, 2 corrupt input."};
   LcmOptions lcm_options;
   SourceOptions source_options;
@@ -50,7 +52,7 @@ int main(int argc, char** argv) {
     CameraNode node(*lcm, options, process_epoch_us());
     announce_ready("evldt-camera", fmt::format("publishing on {} ({})", events_channel(options.camera), lcm_options.effective_url()));
     const CameraSummary summary =
-        node.run([&] { return source_options.open(options.time_slack_us); }, stop);
+        node.run([&] { return source_options.open(options.time_slack_us, stop); }, stop);
     summary.print(stdout);
     return summary.input_error.empty() ? 0 : 2;
   });

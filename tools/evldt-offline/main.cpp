@@ -65,7 +65,8 @@ class FrameSink {
 };
 
 int run(const Options& options, const PipelineOptions& pipeline_options, const SourceOptions& source_options) {
-  const std::unique_ptr<EventSource> opened = source_options.open(pipeline_options.time_slack_us());
+  const std::atomic<bool> never_stop{false};  // a live input is read to its end (Ctrl-C ends the process)
+  const std::unique_ptr<EventSource> opened = source_options.open(pipeline_options.time_slack_us(), never_stop);
   EventSource& source = *opened;
   const auto sensor = pipeline_options.sensor() ? pipeline_options.sensor() : source.geometry();
   if (!sensor) {

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "evldt/app/pipeline_options.hpp"
+#include "evldt/sources/live_bytes.hpp"
 
 namespace evldt {
 
@@ -10,9 +11,19 @@ void SourceOptions::add_to(CLI::App& app) {
   app.add_option("input", recording_,
                  "Recording: Prophesee RAW (EVT 2.0/2.1/3.0) or .dat, ECD events.txt, a ROS 1 or 2 bag (.bag, .db3, .mcap),\n"
                  "AEDAT 2.0/3.1/4.0, Event Stream .es, HDF5 (DSEC, MVSEC, Metavision), or an lcm-log of event batches;\n"
-                 "the format and sensor size come from the file")
+                 "the format and sensor size come from the file. Live: '-' (standard input) or tcp://HOST:PORT, a stream\n"
+                 "of a RAW file (format from its header, else --format)")
+      ->check([](const std::string& input) -> std::string {
+        if (input == "-" || input.starts_with("tcp://")) return {};
+        return CLI::ExistingFile(input);
+      });
+  app.add_option("--follow", followed_,
+                 "Recording that a recorder is still writing (RAW, dat, ECD text, AEDAT 2.0/3.1, .es): events go out as it grows")
       ->check(CLI::ExistingFile);
-  app.add_option("--format", format_, "Recording format when the name does not tell: ecd, evt2, evt3, evt21, dat")
+  app.add_option("--follow-idle-s", follow_idle_s_, "--follow ends once the file has not grown for this long")
+      ->capture_default_str()
+      ->check(finite_number() & CLI::Range(0.01, 86400.0));
+  app.add_option("--format", format_, "Recording format when the name or header does not tell: ecd, evt2, evt3, evt21, dat")
       ->check(CLI::IsMember({"ecd", "evt2", "evt3", "evt21", "dat"}));
   app.add_option("--lcm-channel,--topic", lcm_channel_,
                  "Event channel of an lcm-log, topic of a bag or MCAP file, or event table of an HDF5 file (default: the\n"
@@ -25,10 +36,12 @@ void SourceOptions::add_to(CLI::App& app) {
   simulator_.add_to(app, /*scene_required=*/false);
 }
 
-std::unique_ptr<EventSource> SourceOptions::open(Timestamp backwards_slack_us) const {
-  const int selected = int{!recording_.empty()} + int{simulator_.scene_selected()} + int{!video_.empty()};
+std::unique_ptr<EventSource> SourceOptions::open(Timestamp backwards_slack_us, const std::atomic<bool>& stop) const {
+  const int selected =
+      int{!recording_.empty()} + int{!followed_.empty()} + int{simulator_.scene_selected()} + int{!video_.empty()};
   if (selected != 1) {
-    throw std::invalid_argument("give exactly one source: a recording file, --scene NAME or --from-video FILE|INDEX");
+    throw std::invalid_argument(
+        "give exactly one source: a recording file, '-', tcp://HOST:PORT, --follow FILE, --scene NAME or --from-video FILE|INDEX");
   }
   if (simulator_.scene_selected()) return open_scene(simulator_.scene(), simulator_.config(), simulator_.scene_name());
   if (!video_.empty()) {
@@ -43,6 +56,14 @@ std::unique_ptr<EventSource> SourceOptions::open(Timestamp backwards_slack_us) c
   }
   std::optional<EventFormat> format;
   if (!format_.empty()) format = parse_event_format(format_);
+  if (!followed_.empty()) {
+    return open_stream(std::make_unique<FollowedFileBytes>(followed_, std::chrono::duration<double>(follow_idle_s_), stop),
+                       format, followed_.extension().string());
+  }
+  if (recording_ == "-") return open_stream(std::make_unique<StdinBytes>(stop), format, "");
+  if (recording_.starts_with("tcp://")) {
+    return open_stream(std::make_unique<TcpBytes>(TcpAddress::parse(recording_), stop), format, "");
+  }
   return open_recording(recording_, format, lcm_channel_, backwards_slack_us);
 }
 

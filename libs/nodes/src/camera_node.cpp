@@ -62,15 +62,21 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   summary.sensor = *sensor;
   EventValidator validator(*sensor, options_.time_slack_us);
   EventBatcher batcher(options_.batch_us, options_.max_batch);
-  Pacer pacer(options_.speed);
+  // A live source's events go out as they come: not paced, and each read's last batch at once, not
+  // held until an event of a later window arrives.
+  const bool live = source->live();
+  if (live && options_.loop) throw std::invalid_argument("--loop replays a recording; " + source->name() + " cannot be read again");
+  Pacer pacer(live ? 0.0 : options_.speed);
   EventBatch chunk, batch;
   first_published_t_.reset();
   Timestamp offset = 0;         // added to event times so every loop continues forward in time
   bool rebase = false;
   const auto started = Clock::now();
   auto last_progress = started;
-  spdlog::info("publishing {} ({}x{}) on {} at {}", source->name(), sensor->width, sensor->height, channel_,
-               options_.speed > 0 ? fmt::format("{}x real time", options_.speed) : std::string("full speed"));
+  spdlog::info("publishing {} ({}x{}) on {} {}", source->name(), sensor->width, sensor->height, channel_,
+               live                 ? std::string("as it comes")
+               : options_.speed > 0 ? fmt::format("at {}x real time", options_.speed)
+                                    : std::string("at full speed"));
 
   auto last_stats = started;
   std::uint64_t published_at_last_stats = 0;
@@ -114,7 +120,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
       validator.filter(chunk);
       if (chunk.empty()) continue;
       batcher.push(std::move(chunk));  // chunk gets the storage of a consumed one back
-      publish_ready(false);
+      publish_ready(live);
       if (options_.progress_period_s > 0 &&
           Clock::now() - last_progress > std::chrono::duration<double>(options_.progress_period_s)) {
         last_progress = Clock::now();

@@ -18,18 +18,21 @@ namespace {
 
 class RecordingSource final : public EventSource {
  public:
-  RecordingSource(const std::filesystem::path& path, std::optional<EventFormat> format) : reader_(path, format) {
-    name_ = path.string() + " (" + std::string(format_name(reader_.format())) + ")";
+  RecordingSource(std::unique_ptr<EventStreamReader> reader, bool live) : reader_(std::move(reader)), live_(live) {
+    name_ = reader_->name() + " (" + std::string(format_name(reader_->format())) + (live ? ", live" : "") + ")";
   }
-  bool read(EventBatch& batch) override { return reader_.read(batch); }
-  [[nodiscard]] std::optional<SensorSize> geometry() const override { return reader_.geometry(); }
-  [[nodiscard]] DecodeCounts decode_counts() const override { return reader_.counts(); }
+  bool read(EventBatch& batch) override { return reader_->read(batch); }
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return reader_->geometry(); }
+  [[nodiscard]] DecodeCounts decode_counts() const override { return reader_->counts(); }
   [[nodiscard]] double progress() const override {
-    return static_cast<double>(reader_.bytes_read()) / static_cast<double>(std::max<std::uint64_t>(1, reader_.total_bytes()));
+    if (live_) return 0.0;
+    return static_cast<double>(reader_->bytes_read()) / static_cast<double>(std::max<std::uint64_t>(1, reader_->total_bytes()));
   }
+  [[nodiscard]] bool live() const override { return live_; }
 
  private:
-  EventStreamReader reader_;
+  std::unique_ptr<EventStreamReader> reader_;
+  bool live_;
 };
 
 class ContainerSource final : public EventSource {
@@ -194,7 +197,12 @@ std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, s
       return source;
     }
   }
-  return std::make_unique<RecordingSource>(path, format);
+  return std::make_unique<RecordingSource>(std::make_unique<EventStreamReader>(path, format), false);
+}
+
+std::unique_ptr<EventSource> open_stream(std::unique_ptr<ByteSource> bytes, std::optional<EventFormat> format,
+                                         std::string_view extension) {
+  return std::make_unique<RecordingSource>(std::make_unique<EventStreamReader>(std::move(bytes), format, extension), true);
 }
 
 std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label) {

@@ -1,8 +1,10 @@
 #pragma once
 // Command-line selection of where events come from (shared by evldt-offline and evldt-camera):
-// a recording file, a built-in --scene, or a --from-video file / webcam.
+// a recording file, a live stream of one (standard input "-", tcp://HOST:PORT, --follow FILE being
+// written), a built-in --scene, or a --from-video file / webcam.
 
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -16,11 +18,14 @@ class SourceOptions {
  public:
   void add_to(CLI::App& app);
   /// Opens the one selected source; throws std::invalid_argument unless exactly one was given.
-  /// `backwards_slack_us` checks the time order of an lcm-log's batches.
-  [[nodiscard]] std::unique_ptr<EventSource> open(Timestamp backwards_slack_us) const;
+  /// `backwards_slack_us` checks the time order of an lcm-log's batches; a live source stops waiting
+  /// for bytes once `stop` is set.
+  [[nodiscard]] std::unique_ptr<EventSource> open(Timestamp backwards_slack_us, const std::atomic<bool>& stop) const;
 
  private:
-  std::filesystem::path recording_;
+  std::string recording_;
+  std::filesystem::path followed_;
+  double follow_idle_s_ = 10;
   std::string format_;
   std::string lcm_channel_;
   std::string video_;

@@ -7,7 +7,9 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
+#include "evldt/events/byte_source.hpp"
 #include "evldt/events/event.hpp"
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_format.hpp"
@@ -28,6 +30,9 @@ class EventSource {
   [[nodiscard]] virtual DecodeCounts decode_counts() const { return {}; }
   /// Fraction done, in [0, 1] (0 for a live camera).
   [[nodiscard]] virtual double progress() const = 0;
+  /// Events come as a camera makes them (a growing file, a byte stream): they are not paced, and
+  /// the source cannot be read again.
+  [[nodiscard]] virtual bool live() const { return false; }
   [[nodiscard]] const std::string& name() const { return name_; }
 
  protected:
@@ -41,6 +46,11 @@ class EventSource {
 /// (empty: the first EVENTS_* channel, the first event topic, the first known table).
 std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, std::optional<EventFormat> format,
                                             const std::string& channel, Timestamp backwards_slack_us);
+/// A live stream of bytes in a recording format (RAW EVT 2.0/2.1/3.0, and whatever the file formats
+/// read: see EventStreamReader), the format from `format`, else the first bytes, `extension` or the
+/// header. Blocks until the header has come.
+std::unique_ptr<EventSource> open_stream(std::unique_ptr<ByteSource> bytes, std::optional<EventFormat> format,
+                                         std::string_view extension);
 /// A scene run through the event simulator; `label` names it in logs.
 std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label);
 

@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# Live inputs end to end (issue 26), real processes over UDP multicast on loopback (ttl=0): a RAW
+# recording fed to evldt-camera in pieces of random size with pauses, as a driver or recorder
+# would, through each live path (standard input, a TCP stream, a file followed while it is
+# written) -> evldt-lines -> evldt-viz. Every event of the recording must be published, every
+# batch received by evldt-lines and evldt-viz, and a segment list must include the last batch.
+# Usage: live_test.sh BUILD_DIR SOURCE_DIR
+set -uo pipefail
+build=$1
+source_dir=$2
+source "$source_dir/tests/services/test_lib.sh"
+url="udpm://239.255.76.67:7714?ttl=0"
+sim=$build/tools/evldt-sim/evldt-sim
+
+"$sim" --scene boxes-6dof --duration-s 1 --out-dir "$work/rec" --format evt3 --quiet >/dev/null
+recording=$work/rec/events.raw
+"$camera" "$recording" --lcm-url "$url" --speed 0 -q >"$work/reference.out" 2>"$work/reference.err"
+events=$(field "$work/reference.out" "events +")
+echo "the recording holds $events events"
+
+# Writes the recording in pieces of 1 byte to 20 KiB with pauses of up to 3 ms: to standard
+# output (stdout), to the first client of a TCP port (tcp PORT_FILE: the port it listens on is
+# written there), or appended to a file (append FILE).
+cat >"$work/feed.py" <<'PY'
+import os, random, socket, sys, time
+data = open(sys.argv[1], "rb").read()
+mode = sys.argv[2]
+random.seed(5)
+def pieces():
+    at = 0
+    while at < len(data):
+        size = random.randint(1, 16) if random.random() < 0.25 else random.randint(1, 20000)
+        yield data[at:at + size]
+        at += size
+        time.sleep(random.random() * 0.003)
+if mode == "stdout":
+    out = sys.stdout.buffer
+    for piece in pieces():
+        out.write(piece)
+        out.flush()
+elif mode == "tcp":
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(1)
+    with open(sys.argv[3] + ".tmp", "w") as port_file:
+        port_file.write(str(server.getsockname()[1]))
+    os.rename(sys.argv[3] + ".tmp", sys.argv[3])
+    client, _ = server.accept()
+    for piece in pieces():
+        client.sendall(piece)
+    client.close()
+elif mode == "append":
+    with open(sys.argv[3], "ab") as out:
+        for piece in pieces():
+            out.write(piece)
+            out.flush()
+PY
+
+live_path() {  # live_path NAME CAMERA_ARGS...: the camera on a live input, fed by $feed_pid's writer
+  local name=$1
+  shift
+  "$lines" --lcm-url "$url" --log-period-s 0 --width 240 --height 180 >"$work/$name.lines.out" 2>"$work/$name.lines.err" &
+  local lines_pid=$!
+  "$viz" --lcm-url "$url" --headless --png-dir "$work/$name.png" --png-period-s 0.5 >"$work/$name.viz.out" 2>"$work/$name.viz.err" &
+  local viz_pid=$!
+  "$probe" "$url" cam0 120 >"$work/$name.probe.out" &
+  local probe_pid=$!
+  wait_ready "$work/$name.lines.err" evldt-lines
+  wait_ready "$work/$name.viz.err" evldt-viz
+  wait_until "the probe to subscribe" grep -q '^ready' "$work/$name.probe.out"
+  "$@" >"$work/$name.camera.out" 2>"$work/$name.camera.err"
+  check "$name: camera exits 0" test $? -eq 0
+  cat "$work/$name.camera.out"
+  local batches
+  batches=$(field "$work/$name.camera.out" 'batches')
+  check "$name: every event of the recording published ($events)" \
+    grep -q "events            $events read, $events published" "$work/$name.camera.out"
+  check "$name: a segment list includes the last batch" \
+    wait_until "a segment list including batch $((batches - 1))" probe_heard_batch "$work/$name.probe.out" $((batches - 1))
+  stops_promptly "$lines_pid" >/dev/null
+  stops_promptly "$viz_pid" >/dev/null
+  kill "$probe_pid" 2>/dev/null
+  check "$name: evldt-lines received every batch ($batches)" grep -q "batches   $batches received, 0 lost" "$work/$name.lines.out"
+  check "$name: evldt-viz received every batch" grep -q "received  $batches batches (0 lost" "$work/$name.viz.out"
+}
+
+# 1. Standard input: a driver piping its output.
+live_stdin() { python3 "$work/feed.py" "$recording" stdout | "$camera" - --lcm-url "$url" -q; }
+live_path stdin live_stdin
+
+# 2. A TCP stream.
+python3 "$work/feed.py" "$recording" tcp "$work/port" &
+wait_until "the test server to listen" test -s "$work/port"
+live_path tcp "$camera" "tcp://127.0.0.1:$(cat "$work/port")" --lcm-url "$url" -q
+
+# 3. A file followed while a recorder writes it (the run ends 1 s after it stops growing).
+: >"$work/growing.raw"
+python3 "$work/feed.py" "$recording" append "$work/growing.raw" &
+live_path follow "$camera" --follow "$work/growing.raw" --follow-idle-s 1 --lcm-url "$url" -q
+check "follow: the followed file is the whole recording" cmp -s "$work/growing.raw" "$recording"
+
+finish
