@@ -484,6 +484,7 @@ TEST_P(Truncated, DeliversEveryEventBeforeTheCutThenReportsItsOffset) {
     case EventFormat::Dat: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 5); break;
     case EventFormat::Aedat2:
     case EventFormat::Aedat31:
+    case EventFormat::Aedat31Network:
     case EventFormat::EventStream: FAIL() << "evldt does not write " << format_name(format);
   }
   write_bytes(path, bytes);
@@ -649,6 +650,55 @@ TEST(Aedat, Aedat31PolarityPacketsWithTheirOverflowOtherPacketsSkipped) {
   EXPECT_EQ(cut.events, std::vector<Event>(expected.begin(), expected.begin() + 2));
   ASSERT_TRUE(cut.error);
   EXPECT_EQ(cut.error->byte_offset(), third_packet);
+}
+
+/// libcaer's 20-byte network header (network.h): magic, sequence number, version 1, format, source id.
+void append_aedat3_network_header(std::vector<std::uint8_t>& bytes, std::uint8_t version = 1) {
+  constexpr std::uint64_t kMagic = 0x1D378BC90B9A6658;
+  append_le32(bytes, static_cast<std::uint32_t>(kMagic));
+  append_le32(bytes, static_cast<std::uint32_t>(kMagic >> 32));
+  append_le32(bytes, 0);  // sequence number
+  append_le32(bytes, 0);
+  bytes.push_back(version);
+  bytes.push_back(0);  // format
+  append_le16(bytes, 1);  // source id
+}
+
+TEST(Aedat, Aedat31NetworkStreamIsRecognisedByItsMagicAndDecodedAsTheFilesPackets) {
+  TempDir dir;
+  const fs::path path = dir.file("stream.bin");  // a name that tells nothing
+  std::vector<std::uint8_t> bytes;
+  append_aedat3_network_header(bytes);
+  append_aedat3_packet_header(bytes, 1, 8, 0, 2);
+  append_polarity(bytes, 5, 7, true, 100);
+  append_polarity(bytes, 300, 200, false, 200);
+  append_aedat3_packet_header(bytes, 2, 10, 0, 1);  // another type, skipped
+  bytes.insert(bytes.end(), 10, 0x23);
+  append_aedat3_packet_header(bytes, 1, 8, 1, 1);
+  append_polarity(bytes, 1, 2, true, 5);
+  write_bytes(path, bytes);
+  const std::vector<Event> expected{{100, 5, 7, 1}, {200, 300, 200, -1}, {(Timestamp{1} << 31) + 5, 1, 2, 1}};
+  for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, kOneMiB}) {
+    SCOPED_TRACE(chunk);
+    const ReadResult result = read_file(path, std::nullopt, chunk);
+    EXPECT_FALSE(result.error);
+    EXPECT_EQ(result.events, expected);
+    EventStreamReader reader(path, std::nullopt, chunk);
+    EXPECT_EQ(reader.format(), EventFormat::Aedat31Network);
+    EXPECT_FALSE(reader.geometry());  // the stream names no sensor size
+  }
+  // A wrong version, and a stream cut inside its network header, say so.
+  std::vector<std::uint8_t> version_two;
+  append_aedat3_network_header(version_two, 2);
+  write_bytes(path, version_two);
+  const ReadResult wrong = read_file(path, EventFormat::Aedat31Network, 7);
+  ASSERT_TRUE(wrong.error);
+  EXPECT_NE(std::string(wrong.error->what()).find("version 2"), std::string::npos) << wrong.error->what();
+  bytes.resize(12);
+  write_bytes(path, bytes);
+  const ReadResult cut = read_file(path, EventFormat::Aedat31Network, 7);
+  ASSERT_TRUE(cut.error);
+  EXPECT_NE(std::string(cut.error->what()).find("network header"), std::string::npos) << cut.error->what();
 }
 
 TEST(Aedat, Aedat2AddressesOfDavisAndDvs128ChipsMirroredToATopLeftOrigin) {

@@ -308,6 +308,47 @@ TEST(TcpBytes, AStreamCutInsideAWordKeepsTheEventsBeforeIt) {
   EXPECT_TRUE(got == expected) << "the events before the cut, as from the same bytes in a file";
 }
 
+void append_le(std::vector<std::uint8_t>& bytes, std::uint64_t value, int size) {
+  for (int i = 0; i < size; ++i) bytes.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
+}
+
+/// The events as cAER streams them over TCP: libcaer's network header (network.h), then AEDAT 3.1
+/// polarity packets of 500 events (iniVation's AEDAT 3.1 description).
+std::vector<std::uint8_t> aedat31_network_stream(const std::vector<Event>& events) {
+  std::vector<std::uint8_t> bytes;
+  append_le(bytes, 0x1D378BC90B9A6658, 8);  // magic
+  append_le(bytes, 0, 8);                   // sequence number
+  bytes.push_back(1);                       // version
+  bytes.push_back(0);                       // format
+  append_le(bytes, 1, 2);                   // source id
+  for (std::size_t begin = 0; begin < events.size(); begin += 500) {
+    const std::size_t count = std::min<std::size_t>(500, events.size() - begin);
+    append_le(bytes, 1, 2);  // polarity events
+    append_le(bytes, 1, 2);  // source
+    for (const std::uint64_t field : {8u, 4u, 0u, static_cast<unsigned>(count), static_cast<unsigned>(count), static_cast<unsigned>(count)}) {
+      append_le(bytes, field, 4);  // event size, timestamp offset, overflow, capacity, number, valid
+    }
+    for (std::size_t i = begin; i < begin + count; ++i) {
+      const Event& e = events[i];
+      append_le(bytes, std::uint64_t{e.x} << 17 | std::uint64_t{e.y} << 2 | (e.p > 0 ? 2u : 0u) | 1u, 4);
+      append_le(bytes, static_cast<std::uint64_t>(e.t), 4);
+    }
+  }
+  return bytes;
+}
+
+TEST(TcpBytes, AnAedat31NetworkStreamInRandomPiecesGivesItsEvents) {
+  TempDir dir;
+  EventStreamReader finished(simulated_recording(dir));
+  const std::vector<Event> expected = all_events(finished);
+  TestServer server;
+  server.serve(aedat31_network_stream(expected));
+  const std::atomic<bool> never{false};
+  EventStreamReader streamed(std::make_unique<TcpBytes>(TcpAddress::parse(server.url()), never), std::nullopt, "");
+  EXPECT_EQ(streamed.format(), EventFormat::Aedat31Network);  // told by the network header's magic number
+  EXPECT_TRUE(all_events(streamed) == expected);
+}
+
 TEST(TcpBytes, BadAddressesAndRefusedConnectionsSaySo) {
   EXPECT_THROW(TcpAddress::parse("tcp://nohost"), std::invalid_argument);
   EXPECT_THROW(TcpAddress::parse("udp://a:1"), std::invalid_argument);

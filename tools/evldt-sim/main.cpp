@@ -25,6 +25,7 @@ std::filesystem::path file_for(EventFormat format) {
     case EventFormat::Dat: return "events.dat";
     case EventFormat::Aedat2:
     case EventFormat::Aedat31:
+    case EventFormat::Aedat31Network:
     case EventFormat::EventStream: break;  // not written
   }
   return "events";

@@ -74,13 +74,33 @@ std::optional<std::string> header_value(const TextHeader& header, std::string_vi
   return std::nullopt;
 }
 
+// libcaer's network header (network.h): int64 magic, int64 sequence number, int8 version, int8
+// format, int16 source id, little-endian; a TCP stream sends it once, then the packets.
+constexpr std::size_t kNetworkHeaderBytes = 20;
+constexpr std::uint64_t kNetworkMagic = 0x1D378BC90B9A6658;
+constexpr std::uint8_t kNetworkVersion = 1;
+
+/// An AEDAT 3.1 file ('#' text header) or network stream (network header), then packets.
 class Aedat31Decoder final : public EventDecoder {
  public:
-  explicit Aedat31Decoder(std::string source) : source_(std::move(source)), header_('#') {}
+  Aedat31Decoder(std::string source, bool network) : source_(std::move(source)), header_('#'), network_(network) {}
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
     EventBatch::Appender out(batch);
-    if (!header_.complete()) {
+    if (network_ && network_header_bytes_ < kNetworkHeaderBytes) {
+      const std::size_t take = std::min(chunk.size(), kNetworkHeaderBytes - network_header_bytes_);
+      std::memcpy(network_header_.data() + network_header_bytes_, chunk.data(), take);
+      network_header_bytes_ += take;
+      advance(chunk, take);
+      if (network_header_bytes_ < kNetworkHeaderBytes) return;
+      if (load_le64(network_header_.data()) != kNetworkMagic) {
+        throw FormatError(source_, 0, "not an AEDAT 3.1 network stream (no libcaer network magic number)");
+      }
+      if (network_header_[16] != kNetworkVersion) {
+        throw FormatError(source_, 16, "AEDAT 3 network version " + std::to_string(network_header_[16]) + ", not 1");
+      }
+    }
+    if (!network_ && !header_.complete()) {
       if (!header_.take(chunk, source_)) return;
       read_header();
       offset_ = header_.size();
@@ -109,10 +129,13 @@ class Aedat31Decoder final : public EventDecoder {
   }
 
   void finish(EventBatch&) override {
-    header_.finish(source_);
+    if (network_ && network_header_bytes_ < kNetworkHeaderBytes) {
+      throw FormatError(source_, 0, "stream ends inside the AEDAT 3.1 network header");
+    }
+    if (!network_) header_.finish(source_);
     if (header_bytes_ > 0 || remaining_ > 0) {
       throw FormatError(source_, header_bytes_ > 0 ? offset_ - header_bytes_ : packet_start_,
-                        "file ends inside a packet (a recording cut short)");
+                        network_ ? "stream ends inside a packet" : "file ends inside a packet (a recording cut short)");
     }
   }
 
@@ -166,6 +189,9 @@ class Aedat31Decoder final : public EventDecoder {
 
   std::string source_;
   TextHeader header_;
+  bool network_;
+  std::array<std::uint8_t, kNetworkHeaderBytes> network_header_{};
+  std::size_t network_header_bytes_ = 0;
   std::optional<SensorSize> sensor_;
   std::array<std::uint8_t, kPacketHeaderBytes> packet_header_{};
   std::size_t header_bytes_ = 0;
@@ -260,7 +286,13 @@ class Aedat2Decoder final : public EventDecoder {
 }  // namespace
 
 std::unique_ptr<EventDecoder> make_aedat31_decoder(std::string source_name) {
-  return std::make_unique<Aedat31Decoder>(std::move(source_name));
+  return std::make_unique<Aedat31Decoder>(std::move(source_name), false);
+}
+std::unique_ptr<EventDecoder> make_aedat31_network_decoder(std::string source_name) {
+  return std::make_unique<Aedat31Decoder>(std::move(source_name), true);
+}
+bool starts_as_aedat31_network(std::span<const std::uint8_t> bytes) {
+  return bytes.size() >= 8 && load_le64(bytes.data()) == kNetworkMagic;
 }
 std::unique_ptr<EventDecoder> make_aedat2_decoder(std::string source_name) {
   return std::make_unique<Aedat2Decoder>(std::move(source_name));

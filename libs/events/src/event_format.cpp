@@ -16,6 +16,7 @@ std::optional<EventFormat> parse_event_format(std::string_view name) {
   if (name == "dat") return EventFormat::Dat;
   if (name == "aedat2") return EventFormat::Aedat2;
   if (name == "aedat31") return EventFormat::Aedat31;
+  if (name == "aedat31-net") return EventFormat::Aedat31Network;
   if (name == "es") return EventFormat::EventStream;
   return std::nullopt;
 }
@@ -29,6 +30,7 @@ std::string_view format_name(EventFormat format) {
     case EventFormat::Dat: return "dat";
     case EventFormat::Aedat2: return "aedat2";
     case EventFormat::Aedat31: return "aedat31";
+    case EventFormat::Aedat31Network: return "aedat31-net";
     case EventFormat::EventStream: return "es";
   }
   return "unknown";

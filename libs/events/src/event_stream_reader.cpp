@@ -15,6 +15,7 @@ std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string sourc
     case EventFormat::Dat: return detail::make_dat_decoder(std::move(source_name));
     case EventFormat::Aedat2: return detail::make_aedat2_decoder(std::move(source_name));
     case EventFormat::Aedat31: return detail::make_aedat31_decoder(std::move(source_name));
+    case EventFormat::Aedat31Network: return detail::make_aedat31_network_decoder(std::move(source_name));
     case EventFormat::EventStream: return detail::make_event_stream_decoder(std::move(source_name));
   }
   throw std::invalid_argument("unknown event format");
@@ -63,6 +64,7 @@ EventStreamReader::EventStreamReader(std::unique_ptr<ByteSource> bytes, std::opt
     if (start.starts_with("#!AER-DAT2")) format = EventFormat::Aedat2;
     if (start.starts_with("#!AER-DAT3")) format = EventFormat::Aedat31;
     if (start.starts_with("Event Stream")) format = EventFormat::EventStream;
+    if (detail::starts_as_aedat31_network(header_bytes)) format = EventFormat::Aedat31Network;
   }
   const std::string lower_extension = lowercase(std::string(extension));
   const bool format_from_header = !format && (lower_extension == ".raw" || lower_extension.empty());
@@ -77,7 +79,7 @@ EventStreamReader::EventStreamReader(std::unique_ptr<ByteSource> bytes, std::opt
   }
 
   // Read the text header now so that format() and geometry() are known before the first read().
-  if (format != EventFormat::EcdText && format != EventFormat::EventStream) {
+  if (format != EventFormat::EcdText && format != EventFormat::EventStream && format != EventFormat::Aedat31Network) {
     detail::TextHeader header(format == EventFormat::Aedat2 || format == EventFormat::Aedat31 ? '#' : '%');
     std::size_t consumed = 0;
     for (;;) {

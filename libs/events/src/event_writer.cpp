@@ -45,6 +45,7 @@ std::unique_ptr<EventEncoder> make_encoder(EventFormat format, SensorSize sensor
     case EventFormat::Dat: return detail::make_dat_encoder(sensor);
     case EventFormat::Aedat2:
     case EventFormat::Aedat31:
+    case EventFormat::Aedat31Network:
     case EventFormat::EventStream: throw std::invalid_argument("evldt reads " + std::string(format_name(format)) + " but does not write it");
   }
   throw std::invalid_argument("unknown event format");

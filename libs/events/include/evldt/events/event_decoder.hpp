@@ -86,6 +86,11 @@ std::unique_ptr<EventDecoder> make_dat_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_evt21_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_aedat2_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_aedat31_decoder(std::string source_name);
+/// libcaer's AEDAT 3.1 network stream (TCP): its 20-byte network header (magic, sequence, version),
+/// then the packets of an AEDAT 3.1 file. It names no sensor size.
+std::unique_ptr<EventDecoder> make_aedat31_network_decoder(std::string source_name);
+/// Whether bytes start as libcaer's network header does (its magic number, little-endian).
+bool starts_as_aedat31_network(std::span<const std::uint8_t> bytes);
 std::unique_ptr<EventDecoder> make_event_stream_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_decoder(std::string source_name);
 std::unique_ptr<EventDecoder> make_libcaer_compressed_decoder(std::string source_name);
@@ -154,6 +159,10 @@ inline std::uint16_t load_le16(const std::uint8_t* bytes) {
 inline std::uint32_t load_le32(const std::uint8_t* bytes) {
   return static_cast<std::uint32_t>(bytes[0]) | (static_cast<std::uint32_t>(bytes[1]) << 8) |
          (static_cast<std::uint32_t>(bytes[2]) << 16) | (static_cast<std::uint32_t>(bytes[3]) << 24);
+}
+
+inline std::uint64_t load_le64(const std::uint8_t* bytes) {
+  return static_cast<std::uint64_t>(load_le32(bytes)) | (static_cast<std::uint64_t>(load_le32(bytes + 4)) << 32);
 }
 
 /// Cuts a byte stream arriving in chunks into fixed-size words, carrying a word split by a chunk

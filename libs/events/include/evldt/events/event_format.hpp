@@ -18,6 +18,7 @@ enum class EventFormat {
   Dat,      ///< Prophesee .dat CD events (8-byte records, '%' text header)
   Aedat2,   ///< jAER AEDAT 2.0 (big-endian 8-byte address/time records, '#' text header); read only
   Aedat31,  ///< cAER AEDAT 3.1 (packets of typed events, '#' text header); read only
+  Aedat31Network,  ///< cAER / libcaer's AEDAT 3.1 network stream: a 20-byte network header, then packets; read only
   EventStream,  ///< Event Stream .es 2.x, DVS and ATIS (time deltas in bytes); read only
 };
 
