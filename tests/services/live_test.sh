@@ -75,6 +75,7 @@ live_path() {  # live_path NAME CAMERA_ARGS...: the camera on a live input, fed 
   batches=$(field "$work/$name.camera.out" 'batches')
   check "$name: every event of the recording published ($events)" \
     grep -q "events            $events read, $events published" "$work/$name.camera.out"
+  check "$name: the camera measured its lag from the sensor" grep -qP "live lag +sensor -> publish: median [0-9.]+ ms, p99 [0-9.]+ ms" "$work/$name.camera.out"
   check "$name: a segment list includes the last batch" \
     wait_until "a segment list including batch $((batches - 1))" probe_heard_batch "$work/$name.probe.out" $((batches - 1))
   stops_promptly "$lines_pid" >/dev/null

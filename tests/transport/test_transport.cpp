@@ -19,6 +19,7 @@
 #include "evldt/transport/lcm_log.hpp"
 #include "evldt/transport/messages.hpp"
 #include "evldt/transport/pacer.hpp"
+#include "evldt/transport/sensor_lag.hpp"
 #include "evldt/transport/sequence_tracker.hpp"
 
 namespace evldt {
@@ -98,6 +99,8 @@ stats_t make_stats() {
   msg.events_in = 99;
   msg.filters = "hot-pixel,background-activity";
   msg.filtered_hot_pixel = 7;
+  msg.sensor_lag_samples = 12;
+  msg.sensor_lag_p99_ms = 4.5F;
   msg.masked_pixels = {5, 640 * 3 + 9};
   msg.num_masked_pixels = 2;
   return msg;
@@ -161,6 +164,8 @@ TEST(Messages, StatsRoundTrip) {
   EXPECT_EQ(decoded.service, "evldt-lines");
   EXPECT_EQ(decoded.filters, "hot-pixel,background-activity");
   EXPECT_EQ(decoded.filtered_hot_pixel, 7);
+  EXPECT_EQ(decoded.sensor_lag_samples, 12);
+  EXPECT_FLOAT_EQ(decoded.sensor_lag_p99_ms, 4.5F);
   EXPECT_EQ(decoded.masked_pixels, (std::vector<std::int32_t>{5, 640 * 3 + 9}));
 }
 
@@ -575,6 +580,29 @@ TEST(EventBatchReceiver, AdoptsSensorCountsLossAndRefusesForeignPayloads) {
   EXPECT_EQ(counts.sequence.received, 2u);
   EXPECT_EQ(counts.sequence.lost, 2u);
   EXPECT_EQ(counts.drops.off_sensor, 1u);
+}
+
+TEST(SensorLag, MeasuresEachBatchBeyondTheQuickestAndTheClocksOffset) {
+  SensorLag lag;
+  // A sensor whose clock started 1000 s before the wall clock's epoch: every batch is published
+  // 2 ms after its newest event, every tenth one 12 ms after (held up on the way).
+  constexpr std::int64_t kOffsetUs = 1'000'000'000;
+  for (int i = 0; i < 1000; ++i) {
+    const Timestamp t = i * 1000;
+    lag.published(t, t + kOffsetUs + 2000 + (i % 10 == 9 ? 10'000 : 0));
+  }
+  EXPECT_NEAR(lag.clock_offset_s(), 1000.002, 1e-9);
+  const LatencySummary period = lag.take_summary();
+  EXPECT_EQ(period.samples, 1000u);
+  EXPECT_DOUBLE_EQ(period.median_ms, 0.0);
+  EXPECT_DOUBLE_EQ(period.p99_ms, 10.0);
+  EXPECT_EQ(lag.take_summary().samples, 0u);  // a period's samples are taken once
+  EXPECT_EQ(lag.run_summary().samples, 1000u);
+  // The camera restarts: its clock begins at 0 again. Learnt afresh, the lag is not 1000 s.
+  lag.restart();
+  lag.published(500, 1'000'000'000'000 + 500 + 3000);
+  EXPECT_DOUBLE_EQ(lag.take_summary().p99_ms, 0.0);
+  EXPECT_NEAR(lag.clock_offset_s(), 1'000'000.003, 1e-9);
 }
 
 TEST(LatencyBudget, ShedsWhatQueuedPastTheBudgetWhateverTheSendersClock) {

@@ -38,6 +38,10 @@ void CameraSummary::print(std::FILE* out) const {
                wall_seconds > 0 ? event_seconds / wall_seconds : 0.0, rate * 1e-6,
                static_cast<unsigned long long>(loops), max_lag_s * 1e3, static_cast<unsigned long long>(skipped_gaps),
                static_cast<unsigned long long>(decoded.skipped_words), static_cast<unsigned long long>(decoded.trigger_events));
+  if (live) {
+    std::fprintf(out, "  live lag          sensor -> publish: median %.1f ms, p99 %.1f ms beyond the quickest batch (%u batches); wall - sensor clock %.3f s\n",
+                 sensor_lag.median_ms, sensor_lag.p99_ms, sensor_lag.samples, sensor_clock_offset_s);
+  }
 }
 
 CameraNode::CameraNode(lcm::LCM& lcm, CameraNodeOptions options, std::int64_t epoch_us)
@@ -65,6 +69,9 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   // A live source's events go out as they come: not paced, and each read's last batch at once, not
   // held until an event of a later window arrives.
   const bool live = source->live();
+  summary.live = live;
+  sensor_lag_ = SensorLag();
+  std::uint64_t clock_resets_seen = 0;
   if (live && options_.loop) throw std::invalid_argument("--loop replays a recording; " + source->name() + " cannot be read again");
   Pacer pacer(live ? 0.0 : options_.speed);
   EventBatch chunk, batch;
@@ -95,6 +102,13 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
     while (!stop.load() && batcher.pop(batch, flush)) {
       summary.max_lag_s = std::max(summary.max_lag_s, pacer.wait_until(batch.t.back(), stop));
       publish(batch, summary);
+      if (live) {
+        if (validator.drops().clock_resets != clock_resets_seen) {  // the camera restarted: its clock began afresh
+          clock_resets_seen = validator.drops().clock_resets;
+          sensor_lag_.restart();
+        }
+        sensor_lag_.published(batch.t.back(), header_.utime);
+      }
       stats(false);
     }
   };
@@ -137,6 +151,8 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   summary.decoded += source->decode_counts();
   summary.drops = validator.drops();
   summary.skipped_gaps = pacer.skipped_gaps();
+  summary.sensor_lag = sensor_lag_.run_summary();
+  summary.sensor_clock_offset_s = sensor_lag_.clock_offset_s();
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();
   stats(true);
   return summary;
@@ -157,6 +173,11 @@ void CameraNode::publish_stats(const CameraSummary& summary, const DecodeCounts&
   msg.batches_lost = static_cast<std::int64_t>(summary.publish_failures);
   msg.words_skipped = static_cast<std::int64_t>(decoded.skipped_words);
   msg.trigger_events = static_cast<std::int64_t>(decoded.trigger_events);
+  const LatencySummary lag = sensor_lag_.take_summary();
+  msg.sensor_clock_offset_s = sensor_lag_.clock_offset_s();
+  msg.sensor_lag_samples = static_cast<std::int32_t>(lag.samples);
+  msg.sensor_lag_median_ms = static_cast<float>(lag.median_ms);
+  msg.sensor_lag_p99_ms = static_cast<float>(lag.p99_ms);
   lcm_.publish(std::string(kStatsChannel), &msg);
 }
 

@@ -77,10 +77,12 @@ void VizNode::on_whole_lines(const lcm::ReceiveBuffer* buffer, const std::string
 
 void VizNode::on_stats(const lcm::ReceiveBuffer* buffer, const std::string&) {
   // Other cameras' services and our camera service share the channel: keep our lines service's.
-  if (decode_message(payload_of(buffer), stats_msg_) == WireError::None && stats_msg_.source == options_.camera &&
-      stats_msg_.service == "evldt-lines") {
+  if (decode_message(payload_of(buffer), stats_msg_) != WireError::None || stats_msg_.source != options_.camera) return;
+  if (stats_msg_.service == "evldt-lines") {
     stats_ = stats_msg_;
     ++totals_.stats;
+  } else if (stats_msg_.service == "evldt-camera") {
+    camera_stats_ = stats_msg_;  // a live camera's lag from its sensor
   }
 }
 
@@ -114,6 +116,10 @@ void VizNode::render(cv::Mat& canvas) {
     put_line(canvas, "no statistics from evldt-lines yet", 1);
   }
   int row = 2;
+  if (camera_stats_ && camera_stats_->sensor_lag_samples > 0) {
+    put_line(canvas, fmt::format("camera: sensor lag {:.1f}/{:.1f} ms", camera_stats_->sensor_lag_median_ms, camera_stats_->sensor_lag_p99_ms),
+             row++);
+  }
   if (counts.sequence.lost || counts.invalid_messages) {
     put_line(canvas, fmt::format("viz: {} batches lost, {} invalid", counts.sequence.lost, counts.invalid_messages), row++);
   }

@@ -5,12 +5,20 @@
 
 namespace evldt {
 
-LatencyTracker::LatencyTracker(std::size_t pending_capacity, std::size_t sample_capacity)
-    : ring_(std::max<std::size_t>(pending_capacity, 1)),
-      sample_capacity_(sample_capacity),
-      run_histogram_(static_cast<std::size_t>(1000.0 / kBinMs) + 1) {
+LatencyStatistics::LatencyStatistics(std::size_t sample_capacity)
+    : sample_capacity_(sample_capacity), run_histogram_(static_cast<std::size_t>(1000.0 / kBinMs) + 1) {
   samples_ms_.reserve(sample_capacity);
 }
+
+void LatencyStatistics::add(double latency_ms) {
+  if (samples_ms_.size() < sample_capacity_) samples_ms_.push_back(latency_ms);
+  const double bin = std::clamp(latency_ms / kBinMs, 0.0, static_cast<double>(run_histogram_.size() - 1));
+  ++run_histogram_[static_cast<std::size_t>(bin)];
+  ++run_samples_;
+}
+
+LatencyTracker::LatencyTracker(std::size_t pending_capacity, std::size_t sample_capacity)
+    : ring_(std::max<std::size_t>(pending_capacity, 1)), statistics_(sample_capacity) {}
 
 void LatencyTracker::batch_stored(std::int64_t seq, std::int64_t publish_utime, Timestamp newest_event_us) {
   if (count_ == ring_.size()) {  // forget the oldest
@@ -25,11 +33,7 @@ LatencyTracker::Included LatencyTracker::list_published(Timestamp lattice_us, st
   // Batches arrive in event-time order, so the included ones are a prefix of the ring.
   while (count_ > 0 && ring_[head_].newest_event_us <= lattice_us) {
     const Pending& batch = ring_[head_];
-    const double latency_ms = static_cast<double>(now_utime - batch.utime) * 1e-3;
-    if (samples_ms_.size() < sample_capacity_) samples_ms_.push_back(latency_ms);
-    const double bin = std::clamp(latency_ms / kBinMs, 0.0, static_cast<double>(run_histogram_.size() - 1));
-    ++run_histogram_[static_cast<std::size_t>(bin)];
-    ++run_samples_;
+    statistics_.add(static_cast<double>(now_utime - batch.utime) * 1e-3);
     newest_ = {batch.seq, batch.utime};
     head_ = (head_ + 1) % ring_.size();
     --count_;
@@ -37,7 +41,7 @@ LatencyTracker::Included LatencyTracker::list_published(Timestamp lattice_us, st
   return newest_;
 }
 
-LatencySummary LatencyTracker::take_summary() {
+LatencySummary LatencyStatistics::take_summary() {
   LatencySummary summary;
   summary.samples = static_cast<std::uint32_t>(samples_ms_.size());
   if (!samples_ms_.empty()) {
@@ -53,7 +57,7 @@ LatencySummary LatencyTracker::take_summary() {
   return summary;
 }
 
-LatencySummary LatencyTracker::run_summary() const {
+LatencySummary LatencyStatistics::run_summary() const {
   LatencySummary summary;
   summary.samples = static_cast<std::uint32_t>(std::min<std::uint64_t>(run_samples_, UINT32_MAX));
   if (run_samples_ == 0) return summary;

@@ -15,6 +15,7 @@
 #include "evldt/events/event_validator.hpp"
 #include "evldt/event_batch_t.hpp"
 #include "evldt/sources/event_source.hpp"
+#include "evldt/transport/sensor_lag.hpp"
 
 namespace evldt {
 
@@ -46,6 +47,9 @@ struct CameraSummary {
   double max_lag_s = 0;              ///< furthest behind the pace
   std::uint64_t skipped_gaps = 0;    ///< jumps of event time not waited through (Pacer)
   std::string input_error;           ///< set if the source ended in a format error
+  bool live = false;                 ///< a camera read as it records: the lag below is measured
+  LatencySummary sensor_lag;         ///< sensor clock -> publish, beyond the quickest batch (SensorLag)
+  double sensor_clock_offset_s = 0;  ///< wall clock - sensor clock, as last estimated
 
   void print(std::FILE* out) const;
 };
@@ -73,6 +77,7 @@ class CameraNode {
   event_batch_t header_;             // header fields of the next batch (its arrays stay empty)
   std::vector<std::uint8_t> wire_;   // the encoded batch, reused
   std::optional<Timestamp> first_published_t_;
+  SensorLag sensor_lag_;             // of the live source being published
 };
 
 }  // namespace evldt

@@ -86,6 +86,7 @@ class VizNode {
   Timestamp lines_t_us_ = 0;
   stats_t stats_msg_;
   std::optional<stats_t> stats_;
+  std::optional<stats_t> camera_stats_;  ///< our camera service's, for a live source's lag
   VizTotals totals_;
 };
 

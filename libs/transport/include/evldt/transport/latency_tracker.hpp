@@ -16,6 +16,24 @@ struct LatencySummary {
   double p99_ms = 0;
 };
 
+/// Latencies in ms: a store of the current period's (bounded) and a histogram of the whole run.
+class LatencyStatistics {
+ public:
+  explicit LatencyStatistics(std::size_t sample_capacity = 65536);
+  void add(double latency_ms);
+  /// Median and p99 of the latencies added since the previous call.
+  LatencySummary take_summary();
+  /// Median and p99 since construction, to 0.1 ms (a histogram; latencies above 1 s count as 1 s).
+  [[nodiscard]] LatencySummary run_summary() const;
+
+ private:
+  std::vector<double> samples_ms_;
+  std::size_t sample_capacity_;
+  static constexpr double kBinMs = 0.1;
+  std::vector<std::uint64_t> run_histogram_;  ///< bins of kBinMs up to 1 s
+  std::uint64_t run_samples_ = 0;
+};
+
 class LatencyTracker {
  public:
   /// `pending_capacity`: batches that may wait for a list (the oldest is forgotten beyond it);
@@ -34,9 +52,9 @@ class LatencyTracker {
   Included list_published(Timestamp lattice_us, std::int64_t now_utime);
 
   /// Median and p99 of the latencies recorded since the previous call.
-  LatencySummary take_summary();
+  LatencySummary take_summary() { return statistics_.take_summary(); }
   /// Median and p99 since construction, to 0.1 ms (a histogram; latencies above 1 s count as 1 s).
-  [[nodiscard]] LatencySummary run_summary() const;
+  [[nodiscard]] LatencySummary run_summary() const { return statistics_.run_summary(); }
 
  private:
   struct Pending {
@@ -46,11 +64,7 @@ class LatencyTracker {
   };
   std::vector<Pending> ring_;
   std::size_t head_ = 0, count_ = 0;
-  std::vector<double> samples_ms_;
-  std::size_t sample_capacity_;
-  static constexpr double kBinMs = 0.1;
-  std::vector<std::uint64_t> run_histogram_;  ///< bins of kBinMs up to 1 s
-  std::uint64_t run_samples_ = 0;
+  LatencyStatistics statistics_;
   Included newest_;
 };
 
