@@ -22,6 +22,7 @@
 #include "evldt/events/event_writer.hpp"
 #include "evldt/sim/scenes.hpp"
 #include "evldt/sim/event_simulator.hpp"
+#include "evldt/sources/event_source.hpp"
 #include "evldt/sources/live_bytes.hpp"
 #include "support/temp_dir.hpp"
 
@@ -260,10 +261,14 @@ class TestServer {
     if (thread_.joinable()) thread_.join();
     close(listener_);
   }
-  void serve(std::vector<std::uint8_t> bytes) {
-    thread_ = std::thread([this, bytes = std::move(bytes)] {
-      const int client = accept(listener_, nullptr, nullptr);
-      if (client >= 0) write_in_pieces(client, bytes, 11u);
+  void serve(std::vector<std::uint8_t> bytes) { serve_each({std::move(bytes)}); }
+  /// One stream to each client, in the order they connect.
+  void serve_each(std::vector<std::vector<std::uint8_t>> streams) {
+    thread_ = std::thread([this, streams = std::move(streams)] {
+      for (const auto& bytes : streams) {
+        const int client = accept(listener_, nullptr, nullptr);
+        if (client >= 0) write_in_pieces(client, bytes, 11u);
+      }
     });
   }
   [[nodiscard]] std::string url() const { return "tcp://127.0.0.1:" + std::to_string(port_); }
@@ -347,6 +352,53 @@ TEST(TcpBytes, AnAedat31NetworkStreamInRandomPiecesGivesItsEvents) {
   EventStreamReader streamed(std::make_unique<TcpBytes>(TcpAddress::parse(server.url()), never), std::nullopt, "");
   EXPECT_EQ(streamed.format(), EventFormat::Aedat31Network);  // told by the network header's magic number
   EXPECT_TRUE(all_events(streamed) == expected);
+}
+
+TEST(ReconnectingStream, AServerThatRestartsMidStreamDeliversEveryEventOnce) {
+  TempDir dir;
+  EventStreamReader finished(simulated_recording(dir));
+  const std::vector<Event> expected = all_events(finished);
+  const std::size_t half = expected.size() / 1000 * 500;  // a packet boundary (500 events a packet)
+  TestServer server;
+  // The server goes away after the first half and comes back with a stream of its own (its network
+  // header again) that goes on from where the first ended.
+  server.serve_each({aedat31_network_stream({expected.begin(), expected.begin() + static_cast<std::ptrdiff_t>(half)}),
+                     aedat31_network_stream({expected.begin() + static_cast<std::ptrdiff_t>(half), expected.end()})});
+  std::atomic<bool> stop{false};
+  const TcpAddress address = TcpAddress::parse(server.url());
+  const auto source = open_reconnecting_stream([&] { return std::make_unique<TcpBytes>(address, stop); }, std::nullopt, stop);
+  EXPECT_TRUE(source->live());
+  std::vector<Event> got;
+  EventBatch batch;
+  while (got.size() < expected.size() && source->read(batch)) {
+    for (std::size_t i = 0; i < batch.size(); ++i) got.push_back(batch[i]);
+  }
+  EXPECT_TRUE(got == expected) << got.size() << " of " << expected.size() << " events";
+  EXPECT_GE(source->reconnects(), 1u);
+  stop = true;  // the server is gone for good: stopping ends the reading
+  const auto stopped = std::chrono::steady_clock::now();
+  while (source->read(batch)) {
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - stopped, 3s);
+}
+
+TEST(ReconnectingStream, WaitsForAServerNotYetUpAndStopEndsTheWait) {
+  std::string url;
+  {
+    TestServer closed;
+    url = closed.url();
+  }
+  std::atomic<bool> stop{false};
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(600ms);
+    stop = true;
+  });
+  const TcpAddress address = TcpAddress::parse(url);
+  const double cpu_before = thread_cpu_seconds();
+  EXPECT_THROW((void)open_reconnecting_stream([&] { return std::make_unique<TcpBytes>(address, stop); }, std::nullopt, stop),
+               std::runtime_error);
+  EXPECT_LT(thread_cpu_seconds() - cpu_before, 0.05) << "waiting between attempts must not spin";
+  stopper.join();
 }
 
 TEST(TcpBytes, BadAddressesAndRefusedConnectionsSaySo) {

@@ -23,6 +23,9 @@ void SourceOptions::add_to(CLI::App& app) {
   app.add_option("--follow-idle-s", follow_idle_s_, "--follow ends once the file has not grown for this long")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.01, 86400.0));
+  app.add_flag("--reconnect", reconnect_,
+               "tcp://: connect again when the server closes the stream, cuts it or cannot be reached (waits 0.1 s\n"
+               "doubling up to 2 s; counted); the run then ends only on SIGINT/SIGTERM");
   app.add_option("--format", format_, "Recording format when the name or header does not tell: ecd, evt2, evt3, evt21, dat")
       ->check(CLI::IsMember({"ecd", "evt2", "evt3", "evt21", "dat"}));
   app.add_option("--lcm-channel,--topic", lcm_channel_,
@@ -56,13 +59,18 @@ std::unique_ptr<EventSource> SourceOptions::open(Timestamp backwards_slack_us, c
   }
   std::optional<EventFormat> format;
   if (!format_.empty()) format = parse_event_format(format_);
+  if (reconnect_ && !recording_.starts_with("tcp://")) throw std::invalid_argument("--reconnect is for a tcp:// input");
   if (!followed_.empty()) {
     return open_stream(std::make_unique<FollowedFileBytes>(followed_, std::chrono::duration<double>(follow_idle_s_), stop),
                        format, followed_.extension().string());
   }
   if (recording_ == "-") return open_stream(std::make_unique<StdinBytes>(stop), format, "");
   if (recording_.starts_with("tcp://")) {
-    return open_stream(std::make_unique<TcpBytes>(TcpAddress::parse(recording_), stop), format, "");
+    const TcpAddress address = TcpAddress::parse(recording_);
+    if (reconnect_) {
+      return open_reconnecting_stream([address, &stop] { return std::make_unique<TcpBytes>(address, stop); }, format, stop);
+    }
+    return open_stream(std::make_unique<TcpBytes>(address, stop), format, "");
   }
   return open_recording(recording_, format, lcm_channel_, backwards_slack_us);
 }

@@ -39,8 +39,10 @@ void CameraSummary::print(std::FILE* out) const {
                static_cast<unsigned long long>(loops), max_lag_s * 1e3, static_cast<unsigned long long>(skipped_gaps),
                static_cast<unsigned long long>(decoded.skipped_words), static_cast<unsigned long long>(decoded.trigger_events));
   if (live) {
-    std::fprintf(out, "  live lag          sensor -> publish: median %.1f ms, p99 %.1f ms beyond the quickest batch (%u batches); wall - sensor clock %.3f s\n",
-                 sensor_lag.median_ms, sensor_lag.p99_ms, sensor_lag.samples, sensor_clock_offset_s);
+    std::fprintf(out, "  live lag          sensor -> publish: median %.1f ms, p99 %.1f ms beyond the quickest batch (%u batches); wall - sensor clock %.3f s\n"
+                      "  live input        %llu reconnects\n",
+                 sensor_lag.median_ms, sensor_lag.p99_ms, sensor_lag.samples, sensor_clock_offset_s,
+                 static_cast<unsigned long long>(reconnects));
   }
 }
 
@@ -93,6 +95,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
     if (options_.stats_hz <= 0 || (!final && period_s < 1.0 / options_.stats_hz)) return;
     DecodeCounts decoded = summary.decoded;
     if (!final) decoded += source->decode_counts();  // at the end, summary.decoded holds them all
+    summary.reconnects = source->reconnects();
     publish_stats(summary, decoded, final ? summary.drops : validator.drops(), period_s,
                   summary.events_published - published_at_last_stats);
     last_stats = now;
@@ -153,6 +156,7 @@ CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomi
   summary.skipped_gaps = pacer.skipped_gaps();
   summary.sensor_lag = sensor_lag_.run_summary();
   summary.sensor_clock_offset_s = sensor_lag_.clock_offset_s();
+  summary.reconnects = source->reconnects();
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();
   stats(true);
   return summary;
@@ -173,6 +177,7 @@ void CameraNode::publish_stats(const CameraSummary& summary, const DecodeCounts&
   msg.batches_lost = static_cast<std::int64_t>(summary.publish_failures);
   msg.words_skipped = static_cast<std::int64_t>(decoded.skipped_words);
   msg.trigger_events = static_cast<std::int64_t>(decoded.trigger_events);
+  msg.reconnects = static_cast<std::int64_t>(summary.reconnects);
   const LatencySummary lag = sensor_lag_.take_summary();
   msg.sensor_clock_offset_s = sensor_lag_.clock_offset_s();
   msg.sensor_lag_samples = static_cast<std::int32_t>(lag.samples);

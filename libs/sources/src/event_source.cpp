@@ -5,7 +5,9 @@
 #include <chrono>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <bit>
 #include <stdexcept>
+#include <thread>
 
 #include "evldt/containers/hdf5_events.hpp"
 #include "evldt/containers/packet_source.hpp"
@@ -33,6 +35,76 @@ class RecordingSource final : public EventSource {
  private:
   std::unique_ptr<EventStreamReader> reader_;
   bool live_;
+};
+
+class ReconnectingSource final : public EventSource {
+ public:
+  ReconnectingSource(std::function<std::unique_ptr<ByteSource>()> connect, std::optional<EventFormat> format,
+                     const std::atomic<bool>& stop)
+      : connect_(std::move(connect)), format_(format), stop_(stop) {
+    if (!connect_once()) throw std::runtime_error("stopped before a connection was made");
+    geometry_ = reader_->geometry();
+    name_ = reader_->name() + " (" + std::string(format_name(reader_->format())) + ", live, reconnecting)";
+  }
+  bool read(EventBatch& batch) override {
+    for (;;) {
+      if (!reader_) {
+        if (!connect_once()) return false;  // stopped
+        ++reconnects_;
+        spdlog::info("{}: connected again ({} reconnects)", name_, reconnects_);
+      }
+      try {
+        if (reader_->read(batch)) return true;
+        spdlog::warn("{}: the stream ended; connecting again", name_);
+      } catch (const FormatError& error) {  // cut inside a word or packet: the events before it were read
+        spdlog::warn("{}: {}; connecting again", name_, error.what());
+      }
+      retire_reader();
+      if (stop_.load()) return false;
+    }
+  }
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return geometry_; }
+  [[nodiscard]] DecodeCounts decode_counts() const override {
+    DecodeCounts counts = retired_counts_;
+    if (reader_) counts += reader_->counts();
+    return counts;
+  }
+  [[nodiscard]] double progress() const override { return 0.0; }
+  [[nodiscard]] bool live() const override { return true; }
+  [[nodiscard]] std::uint64_t reconnects() const override { return reconnects_; }
+
+ private:
+  /// Connects and reads the header, retrying with back-off; false if stopped first.
+  bool connect_once() {
+    constexpr auto kFirstWait = std::chrono::milliseconds(100);
+    constexpr auto kLongestWait = std::chrono::seconds(2);
+    std::chrono::milliseconds wait = kFirstWait;
+    for (std::uint64_t attempt = 1; !stop_.load(); ++attempt) {
+      try {
+        reader_ = std::make_unique<EventStreamReader>(connect_(), format_, "");
+        return true;
+      } catch (const std::runtime_error& error) {  // no server yet, or a stream that broke in its header
+        if (std::has_single_bit(attempt)) spdlog::warn("{} (attempt {}; trying again)", error.what(), attempt);
+      }
+      for (auto waited = std::chrono::milliseconds(0); waited < wait && !stop_.load(); waited += std::chrono::milliseconds(50)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+      wait = std::min<std::chrono::milliseconds>(wait * 2, kLongestWait);
+    }
+    return false;
+  }
+  void retire_reader() {
+    retired_counts_ += reader_->counts();
+    reader_.reset();
+  }
+
+  std::function<std::unique_ptr<ByteSource>()> connect_;
+  std::optional<EventFormat> format_;
+  const std::atomic<bool>& stop_;
+  std::unique_ptr<EventStreamReader> reader_;
+  std::optional<SensorSize> geometry_;
+  DecodeCounts retired_counts_;
+  std::uint64_t reconnects_ = 0;
 };
 
 class ContainerSource final : public EventSource {
@@ -203,6 +275,11 @@ std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, s
 std::unique_ptr<EventSource> open_stream(std::unique_ptr<ByteSource> bytes, std::optional<EventFormat> format,
                                          std::string_view extension) {
   return std::make_unique<RecordingSource>(std::make_unique<EventStreamReader>(std::move(bytes), format, extension), true);
+}
+
+std::unique_ptr<EventSource> open_reconnecting_stream(std::function<std::unique_ptr<ByteSource>()> connect,
+                                                      std::optional<EventFormat> format, const std::atomic<bool>& stop) {
+  return std::make_unique<ReconnectingSource>(std::move(connect), format, stop);
 }
 
 std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label) {

@@ -71,7 +71,7 @@ class WireWalker {
 // Encoded sizes of the fixed parts (see the .lcm files).
 constexpr std::size_t kSegmentWireBytes = 8 + 5 * 4 + 1 + 4 + 8 + 8;
 constexpr std::size_t kStatsMiddleBytes =
-    8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 4 + 2 * 8 + 2 * 8 + 8 + 4 + 2 * 4;  // period_s .. sensor_lag_p99_ms
+    8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 4 + 2 * 8 + 2 * 8 + 8 + 4 + 2 * 4 + 8;  // period_s .. reconnects
 
 template <typename Message>
 WireError check_hash(WireWalker& walker) {

@@ -26,6 +26,7 @@ class SourceOptions {
   std::string recording_;
   std::filesystem::path followed_;
   double follow_idle_s_ = 10;
+  bool reconnect_ = false;
   std::string format_;
   std::string lcm_channel_;
   std::string video_;

@@ -50,6 +50,7 @@ struct CameraSummary {
   bool live = false;                 ///< a camera read as it records: the lag below is measured
   LatencySummary sensor_lag;         ///< sensor clock -> publish, beyond the quickest batch (SensorLag)
   double sensor_clock_offset_s = 0;  ///< wall clock - sensor clock, as last estimated
+  std::uint64_t reconnects = 0;      ///< a live stream's connection made again
 
   void print(std::FILE* out) const;
 };

@@ -3,7 +3,9 @@
 // an lcm-log of event batches among them), a built-in simulated scene, or a video file / webcam turned into
 // events by frame differencing. The offline runner and the camera service read through it.
 
+#include <atomic>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,6 +35,8 @@ class EventSource {
   /// Events come as a camera makes them (a growing file, a byte stream): they are not paced, and
   /// the source cannot be read again.
   [[nodiscard]] virtual bool live() const { return false; }
+  /// Times a live source's connection was made again after it was lost.
+  [[nodiscard]] virtual std::uint64_t reconnects() const { return 0; }
   [[nodiscard]] const std::string& name() const { return name_; }
 
  protected:
@@ -51,6 +55,13 @@ std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, s
 /// header. Blocks until the header has come.
 std::unique_ptr<EventSource> open_stream(std::unique_ptr<ByteSource> bytes, std::optional<EventFormat> format,
                                          std::string_view extension);
+/// A live stream that is connected again when it ends or is cut (a camera server restarting): each
+/// connection from `connect` (which throws std::runtime_error when it cannot be made) is read as a
+/// stream of its own (header, then data); between attempts it waits, without using the CPU, 0.1 s
+/// doubling up to 2 s. Connects before it returns; ends only when `stop` is set (throws
+/// std::runtime_error if stopped before the first connection).
+std::unique_ptr<EventSource> open_reconnecting_stream(std::function<std::unique_ptr<ByteSource>()> connect,
+                                                      std::optional<EventFormat> format, const std::atomic<bool>& stop);
 /// A scene run through the event simulator; `label` names it in logs.
 std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label);
 
