@@ -4,6 +4,8 @@
 #include <cstring>
 #include <fcntl.h>
 #include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <stdexcept>
 #include <sys/inotify.h>
@@ -95,6 +97,13 @@ int connect_tcp(const TcpAddress& address) {
 
 TcpBytes::TcpBytes(const TcpAddress& address, const std::atomic<bool>& stop)
     : DescriptorBytes(connect_tcp(address), "tcp://" + address.host + ":" + address.port, stop, true) {}
+
+std::size_t TcpBytes::read(std::span<std::uint8_t> into) {
+  const std::size_t got = DescriptorBytes::read(into);
+  const int on = 1;
+  setsockopt(fd(), IPPROTO_TCP, TCP_QUICKACK, &on, sizeof on);  // not sticky: again after every read
+  return got;
+}
 
 FollowedFileBytes::FollowedFileBytes(const std::filesystem::path& path, std::chrono::duration<double> idle,
                                      const std::atomic<bool>& stop)

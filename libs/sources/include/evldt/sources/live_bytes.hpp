@@ -23,6 +23,9 @@ class DescriptorBytes : public ByteSource {
   DescriptorBytes& operator=(const DescriptorBytes&) = delete;
   std::size_t read(std::span<std::uint8_t> into) override;
 
+ protected:
+  [[nodiscard]] int fd() const { return fd_; }
+
  private:
   int fd_;
   const std::atomic<bool>& stop_;
@@ -47,6 +50,10 @@ struct TcpAddress {
 class TcpBytes final : public DescriptorBytes {
  public:
   TcpBytes(const TcpAddress& address, const std::atomic<bool>& stop);
+  /// Acknowledges what it read at once (TCP_QUICKACK): a sender whose small writes wait for the
+  /// acknowledgement of the last (Nagle's algorithm) is otherwise held 40 ms by a delayed one
+  /// (measured: p99 40 ms from sensor to publish at 0.8 Mev/s in 2 KiB writes, 3 ms with it).
+  std::size_t read(std::span<std::uint8_t> into) override;
 };
 
 /// A file that a recorder may still be writing: reads what is there, then waits for more (inotify)
