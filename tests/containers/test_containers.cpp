@@ -34,6 +34,7 @@
 struct RawRosMessage {
   std::string type;
   std::vector<std::uint8_t> bytes;
+  std::string definition;  ///< the message definition the bag stores for its connection
 };
 
 namespace ros::message_traits {
@@ -49,7 +50,7 @@ struct DataType<RawRosMessage> {
 };
 template <>
 struct Definition<RawRosMessage> {
-  static const char* value(const RawRosMessage&) { return ""; }
+  static const char* value(const RawRosMessage& message) { return message.definition.c_str(); }
   static const char* value() { return ""; }
 };
 }  // namespace ros::message_traits
@@ -175,6 +176,13 @@ class BagWriter {
   void topic(int id, const std::string& name, const std::string& type) {
     exec("INSERT INTO topics VALUES (" + std::to_string(id) + ", '" + name + "', '" + type + "', 'cdr', '')");
   }
+  /// The definition of a type, as rosbag2 keeps them since Iron (table message_definitions).
+  void definition(const std::string& type, const std::string& text) {
+    exec("CREATE TABLE IF NOT EXISTS message_definitions(id INTEGER PRIMARY KEY, topic_type TEXT NOT NULL,"
+         " encoding TEXT NOT NULL, encoded_message_definition TEXT NOT NULL, type_description_hash TEXT NOT NULL);");
+    exec("INSERT INTO message_definitions (topic_type, encoding, encoded_message_definition, type_description_hash) VALUES ('" +
+         type + "', 'ros2msg', '" + text + "', '')");
+  }
   void message(int topic_id, std::int64_t timestamp, const std::vector<std::uint8_t>& data) {
     sqlite3_stmt* statement = nullptr;
     sqlite3_prepare_v2(db_, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)", -1, &statement, nullptr);
@@ -217,7 +225,9 @@ TEST(Cdr, EventPacketDecodesInEitherByteOrderAndRefusesTruncation) {
     SCOPED_TRACE(little);
     const auto bytes = event_packet_cdr(fields, little);
     std::vector<std::uint8_t> scratch;
-    const RosEventMessage message = decode_ros_event_message(RosSerialization::Cdr, kRos2EventPacketType, bytes, scratch);
+    const auto layout = RosEventLayout::of(RosSerialization::Cdr, kRos2EventPacketType, "");
+    ASSERT_TRUE(layout);
+    const RosEventMessage message = layout->decode(bytes, scratch);
     EXPECT_EQ(message.frame_id, "cam-7");
     EXPECT_EQ(message.width, 640u);
     EXPECT_EQ(message.height, 480u);
@@ -225,8 +235,7 @@ TEST(Cdr, EventPacketDecodesInEitherByteOrderAndRefusesTruncation) {
     EXPECT_EQ(message.encoding, "libcaer");
     EXPECT_EQ(std::vector<std::uint8_t>(message.events.begin(), message.events.end()), fields.events);
     for (std::size_t cut = 0; cut < bytes.size(); cut += 3) {
-      EXPECT_THROW(decode_ros_event_message(RosSerialization::Cdr, kRos2EventPacketType, std::span(bytes).first(cut), scratch),
-                   std::runtime_error)
+      EXPECT_THROW(layout->decode(std::span(bytes).first(cut), scratch), std::runtime_error)
           << cut;
     }
   }
@@ -267,6 +276,37 @@ TEST(Rosbag2, Evt3PacketsAreOneStreamSplitAnywhere) {
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find("/imu (sensor_msgs/msg/Imu)"), std::string::npos) << error.what();
   }
+}
+
+TEST(Rosbag2, AMessageOfThePacketFamilyIsReadByTheDefinitionTheBagKeeps) {
+  TempDir dir;
+  const auto path = dir.file("event_array.db3");
+  const EventBatch events = sweep_events(800, 5'000'000);
+  std::vector<std::uint8_t> words;
+  detail::make_evt3_encoder({640, 480})->encode(events, words);
+  {
+    BagWriter bag(path);
+    bag.topic(1, "/event_camera/events", "event_array_msgs/msg/EventArray");
+    bag.definition("event_array_msgs/msg/EventArray",
+                   "std_msgs/Header header\nstring encoding\nuint32 height\nuint32 width\nuint64 seq\nuint64 time_base\n"
+                   "bool is_bigendian\nuint8[] events\n");
+    CdrWriter cdr(true);
+    cdr.put<std::int32_t>(1700000000);
+    cdr.put<std::uint32_t>(123);
+    cdr.put_string("cam-9");
+    cdr.put_string("evt3");
+    cdr.put<std::uint32_t>(480);
+    cdr.put<std::uint32_t>(640);
+    cdr.put<std::uint64_t>(0);
+    cdr.put<std::uint64_t>(0);
+    cdr.put<std::uint8_t>(0);
+    cdr.put_bytes(words);
+    bag.message(1, 100, cdr.bytes());
+  }
+  const ReadAll result = read_all(path);
+  EXPECT_EQ(result.error, "");
+  EXPECT_EQ(result.events, events_of(events));
+  EXPECT_EQ(result.sensor, (SensorSize{640, 480}));
 }
 
 TEST(Rosbag2, LibcaerPacketsCountFromTheirTimeBaseAcrossTheTimeWrap) {
@@ -524,6 +564,63 @@ TEST(Rosbag1, DvsEventArraysInEveryChunkCompressionAndEventPackets) {
   EXPECT_EQ(packets.sensor, (SensorSize{640, 480}));
 }
 
+// event_array_msgs/EventArray, event_camera_msgs/EventPacket's former name, with its fields in an
+// order of its own: read by the definition the bag or file stores for the topic.
+constexpr const char* kEventArrayFamilyDefinition =
+    "# a message of the EventPacket family\n"
+    "std_msgs/Header header\n"
+    "string encoding\n"
+    "uint32 height\n"
+    "uint32 width\n"
+    "uint64 seq  # sequence number\n"
+    "uint64 time_base\n"
+    "uint8 FLAG=1\n"
+    "bool is_bigendian\n"
+    "uint8[] events\n"
+    "================================================================================\n"
+    "MSG: std_msgs/Header\n"
+    "uint32 seq\n"
+    "time stamp\n"
+    "string frame_id\n";
+
+TEST(Rosbag1, AMessageOfThePacketFamilyIsReadByTheDefinitionItsConnectionStores) {
+  TempDir dir;
+  const auto path = dir.file("event_array.bag");
+  const EventBatch sweep = sweep_events(500, 2'000'000);
+  std::vector<std::uint8_t> words;
+  detail::make_evt3_encoder({640, 480})->encode(sweep, words);
+  RawRosMessage packet{"event_array_msgs/EventArray", {}, kEventArrayFamilyDefinition};
+  put_header(packet.bytes, "prophesee");
+  put_string(packet.bytes, "evt3");
+  put32(packet.bytes, 480);
+  put32(packet.bytes, 640);
+  for (const std::uint64_t value : {std::uint64_t{3}, std::uint64_t{0}}) {  // seq, time_base
+    for (int i = 0; i < 8; ++i) packet.bytes.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
+  }
+  packet.bytes.push_back(0);  // is_bigendian
+  put_string(packet.bytes, std::string(words.begin(), words.end()));
+  {
+    rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
+    bag.write("/event_camera/events", ros::Time(2.0), packet);
+  }
+  const ReadAll read = read_all(path);
+  EXPECT_EQ(read.error, "");
+  EXPECT_EQ(read.events, events_of(sweep));
+  EXPECT_EQ(read.sensor, (SensorSize{640, 480}));
+  // Without a definition the type tells nothing: refused, naming what is read.
+  packet.definition.clear();
+  {
+    rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
+    bag.write("/event_camera/events", ros::Time(2.0), packet);
+  }
+  try {
+    (void)open_recording(path, std::nullopt, "", 1000);
+    ADD_FAILURE() << "read a message type without its definition";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("no topic of an event type"), std::string::npos) << error.what();
+  }
+}
+
 TEST(Rosbag1, ABrokenMessageIsAnErrorNamingItAfterTheEventsBeforeIt) {
   TempDir dir;
   const auto path = dir.file("broken.bag");
@@ -658,8 +755,9 @@ class McapWriter {
     file_.assign(kMcapMagic.begin(), kMcapMagic.end());
     record(file_, 0x01, string_field("ros2") + string_field("evldt test"));
   }
-  void schema(std::uint16_t id, const std::string& name, const std::string& encoding = "ros2msg") {
-    record(target(), 0x03, le(id, 2) + string_field(name) + string_field(encoding) + string_field("# definition"));
+  void schema(std::uint16_t id, const std::string& name, const std::string& encoding = "ros2msg",
+              const std::string& definition = "# definition") {
+    record(target(), 0x03, le(id, 2) + string_field(name) + string_field(encoding) + string_field(definition));
   }
   void channel(std::uint16_t id, std::uint16_t schema, const std::string& topic, const std::string& encoding = "cdr") {
     record(target(), 0x04, le(id, 2) + le(schema, 2) + string_field(topic) + string_field(encoding) + le(0, 4));
@@ -754,6 +852,31 @@ TEST(Mcap, EventPacketsInChunksOfEveryCompressionOrNone) {
     EXPECT_NE(std::string(error.what()).find("channels: /imu (sensor_msgs/msg/Imu, cdr), /event_camera/events"), std::string::npos)
         << error.what();
   }
+}
+
+TEST(Mcap, AMessageOfThePacketFamilyIsReadByItsSchemasDefinition) {
+  TempDir dir;
+  const auto path = dir.file("event_array.mcap");
+  const EventBatch sweep = sweep_events(500, 2'000'000);
+  std::vector<std::uint8_t> words;
+  detail::make_evt3_encoder({640, 480})->encode(sweep, words);
+  std::vector<std::uint8_t> message;
+  put_header(message, "prophesee");
+  put_string(message, "evt3");
+  put32(message, 480);
+  put32(message, 640);
+  for (int i = 0; i < 16; ++i) message.push_back(0);  // seq, time_base
+  message.push_back(0);                                // is_bigendian
+  put_string(message, std::string(words.begin(), words.end()));
+  McapWriter mcap(std::nullopt);
+  mcap.schema(1, "event_array_msgs/EventArray", "ros1msg", kEventArrayFamilyDefinition);
+  mcap.channel(1, 1, "/event_camera/events", "ros1");
+  mcap.message(1, 0, message);
+  mcap.finish(path);
+  const ReadAll read = read_all(path);
+  EXPECT_EQ(read.error, "");
+  EXPECT_EQ(read.events, events_of(sweep));
+  EXPECT_EQ(read.sensor, (SensorSize{640, 480}));
 }
 
 TEST(Mcap, Ros1EventArraysAndTopicChoice) {

@@ -18,7 +18,8 @@ namespace {
 void fuzz_message(evldt::RosSerialization serialization, std::string_view type, std::span<const std::uint8_t> bytes) {
   std::vector<std::uint8_t> scratch;
   try {
-    const auto events = evldt::decode_ros_event_message(serialization, type, bytes, scratch).events;
+    const auto layout = evldt::RosEventLayout::of(serialization, type, "");
+    const auto events = layout->decode(bytes, scratch).events;
     const bool in_message = events.empty() || (events.data() >= bytes.data() && events.data() + events.size() <= bytes.data() + bytes.size());
     const bool repacked = events.data() == scratch.data() && events.size() == scratch.size() && events.size() % 13 == 0;
     evldt::fuzz::require(in_message || repacked, "event bytes outside the message");

@@ -55,6 +55,12 @@ struct Record {
 
 struct Channel {
   std::string topic, type, encoding;
+  std::string definition;  // the schema's data: the .msg text of a ros1msg / ros2msg schema
+};
+
+struct Schema {
+  std::string name;
+  std::string definition;
 };
 
 class McapSource final : public PacketSource {
@@ -85,7 +91,7 @@ class McapSource final : public PacketSource {
       try {
         FieldReader fields(record.content);
         fields.take(2 + 4 + 8 + 8);  // channel id, sequence, log time, publish time
-        const RosEventMessage message = decode_ros_event_message(serialization_, type_, fields.rest(), scratch_);
+        const RosEventMessage message = layout_->decode(fields.rest(), scratch_);
         fill_packet(message, packet);
         if (camera_.empty()) camera_ = message.frame_id;
       } catch (const std::runtime_error& error) {
@@ -150,16 +156,21 @@ class McapSource final : public PacketSource {
       switch (record.opcode) {
         case kSchema: {
           const auto id = fields.read<std::uint16_t>();
-          schemas_[id] = fields.read_string();
+          Schema& schema = schemas_[id];
+          schema.name = fields.read_string();
+          const std::string encoding = fields.read_string();
+          const std::string data = fields.read_string();  // uint32-prefixed bytes, as a string is
+          schema.definition = encoding == "ros1msg" || encoding == "ros2msg" ? data : std::string();
           return false;
         }
         case kChannel: {
           const auto id = fields.read<std::uint16_t>();
           const auto schema = fields.read<std::uint16_t>();
-          Channel channel{fields.read_string(), {}, {}};
+          Channel channel{fields.read_string(), {}, {}, {}};
           channel.encoding = fields.read_string();
           const auto found = schemas_.find(schema);
-          channel.type = found == schemas_.end() ? "no schema" : found->second;
+          channel.type = found == schemas_.end() ? "no schema" : found->second.name;
+          if (found != schemas_.end()) channel.definition = found->second.definition;
           consider(id, channel);
           channels_[id] = std::move(channel);
           return false;
@@ -187,16 +198,16 @@ class McapSource final : public PacketSource {
     if (channel_id_ >= 0) return;
     const bool ros1 = channel.encoding == "ros1", cdr = channel.encoding == "cdr";
     const RosSerialization serialization = ros1 ? RosSerialization::Ros1 : RosSerialization::Cdr;
-    const bool events = (ros1 || cdr) && is_event_message_type(serialization, channel.type);
-    if (!(wanted_.empty() ? events : channel.topic == wanted_)) return;
-    if (!events) {
+    auto layout = ros1 || cdr ? RosEventLayout::of(serialization, channel.type, channel.definition) : std::nullopt;
+    if (!(wanted_.empty() ? layout.has_value() : channel.topic == wanted_)) return;
+    if (!layout) {
       throw std::runtime_error("'" + path_ + "': channel " + channel.topic + " is of type " + channel.type + " (" + channel.encoding +
                                "), not an event type evldt reads");
     }
     channel_id_ = id;
     topic_ = channel.topic;
     type_ = channel.type;
-    serialization_ = serialization;
+    layout_ = std::move(layout);
   }
 
   void open_chunk(FieldReader& fields, std::uint64_t offset) {
@@ -234,11 +245,11 @@ class McapSource final : public PacketSource {
   std::vector<std::uint8_t> chunk_;
   std::size_t chunk_at_ = 0;
   std::uint64_t chunk_offset_ = 0;
-  std::map<std::uint16_t, std::string> schemas_;
+  std::map<std::uint16_t, Schema> schemas_;
   std::map<std::uint16_t, Channel> channels_;
   int channel_id_ = -1;
   std::string topic_, type_, camera_;
-  RosSerialization serialization_ = RosSerialization::Cdr;
+  std::optional<RosEventLayout> layout_;
   std::vector<std::uint8_t> scratch_;
   std::uint64_t read_ = 0, skipped_ = 0;
 };

@@ -96,24 +96,96 @@ void append_le(std::vector<std::uint8_t>& out, std::uint32_t value, int bytes) {
 
 }  // namespace
 
-bool is_event_message_type(RosSerialization serialization, std::string_view type) {
-  return serialization == RosSerialization::Ros1 ? (type == kRos1EventArrayType || type == kRos1EventPacketType)
-                                                 : (type == kRos2EventArrayType || type == kRos2EventPacketType);
+namespace {
+
+// event_camera_msgs/EventPacket, as ros-event-camera's drivers define it.
+constexpr std::string_view kEventPacketDefinition =
+    "std_msgs/Header header\nuint32 height\nuint32 width\nuint64 seq\nuint64 time_base\nstring encoding\n"
+    "bool is_bigendian\nuint8[] events\n";
+
+std::string_view trim(std::string_view text) {
+  const auto first = text.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return {};
+  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
 }
 
-RosEventMessage decode_ros_event_message(RosSerialization serialization, std::string_view type,
-                                         std::span<const std::uint8_t> bytes, std::vector<std::uint8_t>& scratch) {
+bool is_header(std::string_view type) { return type == "Header" || type == "std_msgs/Header" || type == "std_msgs/msg/Header"; }
+
+/// Bytes of a primitive field; 0 for a type that is not one.
+std::size_t primitive_bytes(std::string_view type) {
+  if (type == "bool" || type == "uint8" || type == "int8" || type == "byte" || type == "char") return 1;
+  if (type == "uint16" || type == "int16") return 2;
+  if (type == "uint32" || type == "int32" || type == "float32") return 4;
+  if (type == "uint64" || type == "int64" || type == "float64") return 8;
+  return 0;
+}
+
+}  // namespace
+
+std::vector<RosEventLayout::Field> parse_message_fields(std::string_view definition) {
+  std::vector<RosEventLayout::Field> fields;
+  while (!definition.empty()) {
+    const auto end = definition.find('\n');
+    std::string_view line = definition.substr(0, end);
+    definition = end == std::string_view::npos ? std::string_view{} : definition.substr(end + 1);
+    if (line.starts_with("===")) break;  // the definitions of nested types follow
+    line = trim(line.substr(0, line.find('#')));
+    const auto space = line.find_first_of(" \t");
+    if (line.empty() || space == std::string_view::npos) continue;
+    const std::string_view type = line.substr(0, space);
+    std::string_view name = trim(line.substr(space));
+    if (name.find('=') != std::string_view::npos) continue;  // a constant
+    name = name.substr(0, name.find_first_of(" \t"));        // ROS 2 may give a default value after the name
+    fields.push_back({std::string(type), std::string(name)});
+  }
+  return fields;
+}
+
+std::optional<RosEventLayout> RosEventLayout::of(RosSerialization serialization, std::string_view type, std::string_view definition) {
+  RosEventLayout layout;
+  layout.serialization_ = serialization;
   const bool ros1 = serialization == RosSerialization::Ros1;
-  if (!is_event_message_type(serialization, type)) throw std::runtime_error("type " + std::string(type) + " holds no events evldt reads");
-  MessageReader reader(serialization, bytes);
+  if (type == (ros1 ? kRos1EventArrayType : kRos2EventArrayType)) {
+    layout.dvs_event_array_ = true;
+    return layout;
+  }
+  const auto of_the_family = [](const std::vector<Field>& fields) {
+    bool header = false, encoding = false, events = false;
+    for (const Field& field : fields) {
+      if (is_header(field.type)) {
+        header = true;
+      } else if (field.type == "string") {
+        encoding = encoding || field.name == "encoding";
+      } else if (field.type == "uint8[]" && field.name == "events") {
+        events = true;
+      } else if (primitive_bytes(field.type) == 0) {
+        return false;  // arrays, nested messages: not of the family
+      }
+    }
+    return header && encoding && events;
+  };
+  layout.fields_ = parse_message_fields(definition);
+  if (of_the_family(layout.fields_)) return layout;
+  // A known packet type whose stored definition is missing or unreadable: its published layout.
+  if (type != (ros1 ? kRos1EventPacketType : kRos2EventPacketType)) return std::nullopt;
+  layout.fields_ = parse_message_fields(kEventPacketDefinition);
+  return layout;
+}
+
+RosEventMessage RosEventLayout::decode(std::span<const std::uint8_t> bytes, std::vector<std::uint8_t>& scratch) const {
+  const bool ros1 = serialization_ == RosSerialization::Ros1;
+  MessageReader reader(serialization_, bytes);
   RosEventMessage message;
-  if (ros1) reader.read<std::uint32_t>();  // header.seq (ROS 1 only)
-  reader.read<std::uint32_t>();            // header.stamp.sec
-  reader.read<std::uint32_t>();            // header.stamp.nsec
-  message.frame_id = reader.read_string();
-  message.height = reader.read<std::uint32_t>();
-  message.width = reader.read<std::uint32_t>();
-  if (type == kRos1EventArrayType || type == kRos2EventArrayType) {
+  const auto read_header = [&] {
+    if (ros1) reader.read<std::uint32_t>();  // header.seq (ROS 1 only)
+    reader.read<std::uint32_t>();            // header.stamp.sec
+    reader.read<std::uint32_t>();            // header.stamp.nsec
+    message.frame_id = reader.read_string();
+  };
+  if (dvs_event_array_) {
+    read_header();
+    message.height = reader.read<std::uint32_t>();
+    message.width = reader.read<std::uint32_t>();
     message.encoding = "dvs_events";
     if (ros1) {
       message.events = reader.read_span(std::size_t{reader.read_count(kDvsEventBytes)} * kDvsEventBytes);
@@ -132,11 +204,28 @@ RosEventMessage decode_ros_event_message(RosSerialization serialization, std::st
     message.events = scratch;
     return message;
   }
-  reader.read<std::uint64_t>();  // seq
-  message.time_base = reader.read<std::uint64_t>();
-  message.encoding = reader.read_string();
-  if (reader.read<std::uint8_t>() != 0) throw std::runtime_error("big-endian event data is not supported");
-  message.events = reader.read_bytes();
+  for (const Field& field : fields_) {
+    if (is_header(field.type)) {
+      read_header();
+    } else if (field.type == "string") {
+      std::string text = reader.read_string();
+      if (field.name == "encoding") message.encoding = std::move(text);
+    } else if (field.type == "uint8[]") {
+      message.events = reader.read_bytes();
+    } else {
+      std::uint64_t value = 0;
+      switch (primitive_bytes(field.type)) {
+        case 1: value = reader.read<std::uint8_t>(); break;
+        case 2: value = reader.read<std::uint16_t>(); break;
+        case 4: value = reader.read<std::uint32_t>(); break;
+        default: value = reader.read<std::uint64_t>(); break;
+      }
+      if (field.name == "width") message.width = static_cast<std::uint32_t>(value);
+      if (field.name == "height") message.height = static_cast<std::uint32_t>(value);
+      if (field.name == "time_base") message.time_base = value;
+      if (field.name == "is_bigendian" && value != 0) throw std::runtime_error("big-endian event data is not supported");
+    }
+  }
   return message;
 }
 

@@ -11,8 +11,6 @@
 namespace evldt {
 namespace {
 
-bool is_event_type(const std::string& type) { return is_event_message_type(RosSerialization::Ros1, type); }
-
 class Rosbag1Source final : public PacketSource {
  public:
   Rosbag1Source(const std::filesystem::path& path, const std::string& topic) : path_(path.string()) {
@@ -23,13 +21,16 @@ class Rosbag1Source final : public PacketSource {
       for (const rosbag::ConnectionInfo* connection : all.getConnections()) {
         listing += (listing.empty() ? "" : ", ") + connection->topic + " (" + connection->datatype + ")";
         if (!topic_.empty()) continue;
-        if (topic.empty() ? is_event_type(connection->datatype) : connection->topic == topic) {
-          if (!is_event_type(connection->datatype)) {
+        // The layout from the definition the bag stores for the connection.
+        auto layout = RosEventLayout::of(RosSerialization::Ros1, connection->datatype, connection->msg_def);
+        if (topic.empty() ? layout.has_value() : connection->topic == topic) {
+          if (!layout) {
             throw std::runtime_error("topic " + topic + " is of type " + connection->datatype + ", not " +
-                                     std::string(kRos1EventArrayType) + " or " + std::string(kRos1EventPacketType));
+                                     std::string(kKnownEventTypes));
           }
           topic_ = connection->topic;
           type_ = connection->datatype;
+          layout_ = std::move(layout);
         }
       }
       if (topic_.empty()) {
@@ -54,7 +55,7 @@ class Rosbag1Source final : public PacketSource {
       buffer_.resize(message.size());
       ros::serialization::OStream stream(buffer_.data(), static_cast<std::uint32_t>(buffer_.size()));
       message.write(stream);
-      const RosEventMessage decoded = decode_ros_event_message(RosSerialization::Ros1, message.getDataType(), buffer_, scratch_);
+      const RosEventMessage decoded = layout_->decode(buffer_, scratch_);
       fill_packet(decoded, packet);
       if (camera_.empty()) camera_ = decoded.frame_id;
       ++read_;
@@ -79,6 +80,7 @@ class Rosbag1Source final : public PacketSource {
   std::string path_;
   rosbag::Bag bag_;
   std::string topic_, type_, camera_;
+  std::optional<RosEventLayout> layout_;
   std::optional<rosbag::View> view_;
   rosbag::View::iterator next_;
   std::uint64_t total_ = 0, read_ = 0;

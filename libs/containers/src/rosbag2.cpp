@@ -68,7 +68,7 @@ class Rosbag2Source final : public PacketSource {
     const auto size = static_cast<std::size_t>(sqlite3_column_bytes(messages_->get(), 1));
     packet.location = "message id " + std::to_string(id);
     try {
-      const RosEventMessage message = decode_ros_event_message(RosSerialization::Cdr, type_, {data, size}, scratch_);
+      const RosEventMessage message = layout_->decode({data, size}, scratch_);
       fill_packet(message, packet);
       if (camera_.empty()) camera_ = message.frame_id;
     } catch (const std::runtime_error& error) {
@@ -86,6 +86,20 @@ class Rosbag2Source final : public PacketSource {
   [[nodiscard]] std::uint64_t skipped_packets() const override { return 0; }  // other topics are not read
 
  private:
+  /// The .msg definition of `type` where the bag keeps one (rosbag2 since Iron: message_definitions);
+  /// empty otherwise.
+  std::string message_definition(const std::string& type) const {
+    sqlite3_stmt* statement = nullptr;
+    if (sqlite3_prepare_v2(db_, "SELECT encoded_message_definition FROM message_definitions WHERE topic_type = ? AND encoding = 'ros2msg'",
+                           -1, &statement, nullptr) != SQLITE_OK) {
+      return {};  // an older bag: no such table
+    }
+    sqlite3_bind_text(statement, 1, type.c_str(), -1, SQLITE_TRANSIENT);
+    std::string definition = sqlite3_step(statement) == SQLITE_ROW ? column_text(statement, 0) : std::string();
+    sqlite3_finalize(statement);
+    return definition;
+  }
+
   void choose_topic(const std::string& wanted) {
     Statement topics(db_, "SELECT id, name, type FROM topics ORDER BY id");
     std::string listing;
@@ -94,15 +108,15 @@ class Rosbag2Source final : public PacketSource {
       const std::string name = column_text(topics.get(), 1), type = column_text(topics.get(), 2);
       listing += (listing.empty() ? "" : ", ") + name + " (" + type + ")";
       if (topic_id_ >= 0) continue;
-      const bool events = is_event_message_type(RosSerialization::Cdr, type);
-      if (wanted.empty() ? events : name == wanted) {
-        if (!events) {
-          throw std::runtime_error("topic " + name + " is of type " + type + ", not " + std::string(kRos2EventPacketType) +
-                                   " or " + std::string(kRos2EventArrayType));
+      auto layout = RosEventLayout::of(RosSerialization::Cdr, type, message_definition(type));
+      if (wanted.empty() ? layout.has_value() : name == wanted) {
+        if (!layout) {
+          throw std::runtime_error("topic " + name + " is of type " + type + ", not " + std::string(kKnownEventTypes));
         }
         topic_id_ = id;
         topic_ = name;
         type_ = type;
+        layout_ = std::move(layout);
       }
     }
     if (topic_id_ < 0) {
@@ -115,6 +129,7 @@ class Rosbag2Source final : public PacketSource {
   sqlite3* db_ = nullptr;
   std::int64_t topic_id_ = -1;
   std::string topic_, type_;
+  std::optional<RosEventLayout> layout_;
   std::string camera_;
   std::vector<std::uint8_t> scratch_;
   std::uint64_t total_ = 0, read_ = 0;

@@ -5,9 +5,13 @@
 //     events[] of {uint16 x, uint16 y, time ts, bool polarity} -> encoding "dvs_events";
 //   event_camera_msgs/EventPacket (ros-event-camera's drivers): header, height, width, seq,
 //     time_base (ns), encoding, is_bigendian, uint8[] events -> the packet's own encoding.
+//   any message of that packet family (event_array_msgs/EventArray, its former name, among them),
+//     read by the fields of the message definition the bag stores: a header, a string encoding, a
+//     uint8[] of events, and primitive fields (width, height, time_base, is_bigendian...) in any order.
 // ROS 1 serialization is little-endian and packed; ROS 2's CDR aligns each primitive to its size.
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -24,8 +28,6 @@ inline constexpr std::string_view kRos2EventPacketType = "event_camera_msgs/msg/
 
 enum class RosSerialization { Ros1, Cdr };
 
-/// Whether evldt decodes messages of `type` (a name of the serialization's ROS version).
-bool is_event_message_type(RosSerialization serialization, std::string_view type);
 
 /// The fields of an event message that a reader uses.
 struct RosEventMessage {
@@ -36,11 +38,40 @@ struct RosEventMessage {
   std::span<const std::uint8_t> events;  ///< into the message, or into `scratch`
 };
 
-/// Decodes a message of an event type. An EventArray in CDR, whose records are padded by their
-/// alignment, is repacked into `scratch` as dvs_events records. Throws std::runtime_error with the
-/// reason (and offset) when the bytes are not such a message, or the event data is big-endian.
-RosEventMessage decode_ros_event_message(RosSerialization serialization, std::string_view type,
-                                         std::span<const std::uint8_t> bytes, std::vector<std::uint8_t>& scratch);
+/// How one topic's messages are read.
+class RosEventLayout {
+ public:
+  /// The layout for messages of `type` as `definition` (the message definition a bag stores for the
+  /// topic, empty where it stores none) describes them: dvs_msgs/EventArray, or a message of the
+  /// packet family (event_camera_msgs/EventPacket is known without a definition); nullopt if such
+  /// messages hold no events evldt reads.
+  static std::optional<RosEventLayout> of(RosSerialization serialization, std::string_view type, std::string_view definition);
+
+  /// Decodes a message. An EventArray in CDR, whose records are padded by their alignment, is repacked
+  /// into `scratch` as dvs_events records. Throws std::runtime_error with the reason (and offset)
+  /// when the bytes are not such a message, or the event data is big-endian.
+  RosEventMessage decode(std::span<const std::uint8_t> bytes, std::vector<std::uint8_t>& scratch) const;
+
+  /// One top-level field of a message definition: its type and name ("uint32", "width").
+  struct Field {
+    std::string type;
+    std::string name;
+  };
+
+ private:
+  RosSerialization serialization_ = RosSerialization::Ros1;
+  bool dvs_event_array_ = false;
+  std::vector<Field> fields_;  // of a packet-family message
+};
+
+/// The top-level fields of a ROS message definition as bags store it: "TYPE NAME" lines up to the
+/// first "===" line (the definitions of nested types follow it); comments, constants and blank
+/// lines skipped.
+std::vector<RosEventLayout::Field> parse_message_fields(std::string_view definition);
+
+/// The message types evldt reads without a definition, for messages naming what it wanted.
+inline constexpr std::string_view kKnownEventTypes =
+    "dvs_msgs/EventArray, event_camera_msgs/EventPacket, or a message of that family with its definition";
 
 /// The message's events, encoding, time base and sensor size into `packet`.
 void fill_packet(const RosEventMessage& message, RecordingPacket& packet);
