@@ -9,6 +9,7 @@
 #include <netinet/in.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -18,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "aedat4_header_generated.h"
 #include "evldt/events/event_stream_reader.hpp"
 #include "evldt/events/event_writer.hpp"
 #include "evldt/sim/scenes.hpp"
@@ -366,7 +368,8 @@ TEST(ReconnectingStream, AServerThatRestartsMidStreamDeliversEveryEventOnce) {
                      aedat31_network_stream({expected.begin() + static_cast<std::ptrdiff_t>(half), expected.end()})});
   std::atomic<bool> stop{false};
   const TcpAddress address = TcpAddress::parse(server.url());
-  const auto source = open_reconnecting_stream([&] { return std::make_unique<TcpBytes>(address, stop); }, std::nullopt, stop);
+  const auto source =
+      open_reconnecting([&] { return open_stream(std::make_unique<TcpBytes>(address, stop), std::nullopt, ""); }, stop);
   EXPECT_TRUE(source->live());
   std::vector<Event> got;
   EventBatch batch;
@@ -395,10 +398,112 @@ TEST(ReconnectingStream, WaitsForAServerNotYetUpAndStopEndsTheWait) {
   });
   const TcpAddress address = TcpAddress::parse(url);
   const double cpu_before = thread_cpu_seconds();
-  EXPECT_THROW((void)open_reconnecting_stream([&] { return std::make_unique<TcpBytes>(address, stop); }, std::nullopt, stop),
+  EXPECT_THROW((void)open_reconnecting([&] { return open_stream(std::make_unique<TcpBytes>(address, stop), std::nullopt, ""); }, stop),
                std::runtime_error);
   EXPECT_LT(thread_cpu_seconds() - cpu_before, 0.05) << "waiting between attempts must not spin";
   stopper.join();
+}
+
+/// An AEDAT 4.0 file as DV's network output streams it: the size-prefixed IOHeader and the packets,
+/// without the version line and the data table; `first`, `last`: the packets to send ([first, last)).
+struct Aedat4File {
+  std::vector<std::uint8_t> header;                          // size prefix and IOHeader
+  std::vector<std::pair<std::size_t, std::size_t>> packets;  // offset and length of each, header included
+  std::vector<std::uint8_t> bytes;
+
+  explicit Aedat4File(const std::filesystem::path& path) : bytes(file_bytes(path)) {
+    const std::size_t at = std::string_view("#!AER-DAT4.0\r\n").size();
+    const std::uint32_t size = load_le32(bytes.data() + at);
+    header.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at), bytes.begin() + static_cast<std::ptrdiff_t>(at + 4 + size));
+    const auto* io = aedat4::GetSizePrefixedIOHeader(header.data());
+    const auto end = io->dataTablePosition() >= 0 ? static_cast<std::size_t>(io->dataTablePosition()) : bytes.size();
+    for (std::size_t packet = at + 4 + size; packet + 8 <= end;) {
+      const std::size_t length = 8 + load_le32(bytes.data() + packet + 4);
+      packets.emplace_back(packet, length);
+      packet += length;
+    }
+  }
+  [[nodiscard]] std::vector<std::uint8_t> stream(std::size_t first, std::size_t last) const {
+    std::vector<std::uint8_t> out = header;
+    for (std::size_t i = first; i < last; ++i) {
+      const auto [offset, length] = packets[i];
+      out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(offset), bytes.begin() + static_cast<std::ptrdiff_t>(offset + length));
+    }
+    return out;
+  }
+  static std::uint32_t load_le32(const std::uint8_t* p) {
+    return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16 |
+           static_cast<std::uint32_t>(p[3]) << 24;
+  }
+};
+
+TEST(DvNetworkStream, ARealRecordingStreamedWithADisconnectArrivesOnceEveryEvent) {
+  const auto recording = real_recording("dvxplorer_person.aedat4");
+  if (!std::filesystem::exists(recording)) GTEST_SKIP() << "no " << recording << " (../shared is absent)";
+  std::vector<Event> expected;
+  std::optional<SensorSize> sensor;
+  {
+    const auto file = open_recording(recording, std::nullopt, "", 1000);
+    sensor = file->geometry();
+    EventBatch batch;
+    while (file->read(batch)) {
+      for (std::size_t i = 0; i < batch.size(); ++i) expected.push_back(batch[i]);
+    }
+  }
+  ASSERT_FALSE(expected.empty());
+  const Aedat4File file(recording);
+  ASSERT_GT(file.packets.size(), 2u);
+  const std::size_t middle = file.packets.size() / 2;
+  TestServer server;
+  // The server goes away in the middle and comes back, sending its header again, then the rest.
+  server.serve_each({file.stream(0, middle), file.stream(middle, file.packets.size())});
+  std::atomic<bool> stop{false};
+  const TcpAddress address = TcpAddress::parse(server.url());
+  const auto source = open_reconnecting([&] { return open_dv_stream(std::make_unique<TcpBytes>(address, stop)); }, stop);
+  EXPECT_EQ(source->geometry(), sensor);  // from the stream's header
+  std::vector<Event> got;
+  EventBatch batch;
+  while (got.size() < expected.size() && source->read(batch)) {
+    for (std::size_t i = 0; i < batch.size(); ++i) got.push_back(batch[i]);
+  }
+  EXPECT_EQ(got.size(), expected.size());
+  EXPECT_TRUE(got == expected);
+  EXPECT_GE(source->reconnects(), 1u);
+  stop = true;
+}
+
+TEST(DvNetworkStream, AUnixSocketStreamCutInsideAPacketKeepsTheEventsBeforeIt) {
+  const auto recording = real_recording("dvxplorer_person.aedat4");
+  if (!std::filesystem::exists(recording)) GTEST_SKIP() << "no " << recording << " (../shared is absent)";
+  const Aedat4File file(recording);
+  std::vector<std::uint8_t> cut = file.stream(0, file.packets.size());
+  cut.resize(cut.size() - 3);  // inside the last packet
+  TempDir dir;
+  const std::string path = dir.file("dv.sock").string();
+  const int listener = socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  path.copy(address.sun_path, path.size());
+  ASSERT_EQ(bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  ASSERT_EQ(listen(listener, 1), 0);
+  std::thread server([&] {
+    const int client = accept(listener, nullptr, nullptr);
+    if (client >= 0) write_in_pieces(client, cut, 13u);
+  });
+  const std::atomic<bool> never{false};
+  const auto source = open_dv_stream(std::make_unique<UnixSocketBytes>(path, never));
+  std::size_t events = 0;
+  std::string error;
+  EventBatch batch;
+  try {
+    while (source->read(batch)) events += batch.size();
+  } catch (const FormatError& fault) {
+    error = fault.what();
+  }
+  server.join();
+  close(listener);
+  EXPECT_GT(events, 0u);
+  EXPECT_NE(error.find("stream ends inside a"), std::string::npos) << "error: '" << error << "'";
 }
 
 TEST(TcpBytes, BadAddressesAndRefusedConnectionsSaySo) {

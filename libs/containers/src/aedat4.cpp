@@ -2,6 +2,7 @@
 
 #include <flatbuffers/flatbuffers.h>
 
+#include <limits>
 #include <map>
 #include <stdexcept>
 
@@ -78,11 +79,17 @@ std::map<int, StreamInfo> parse_streams(std::string_view xml) {
 
 class Aedat4Source final : public PacketSource {
  public:
-  explicit Aedat4Source(const std::filesystem::path& path) : file_(path, "AEDAT 4"), path_(file_.path()) {
-    std::string magic(kAedat4Magic.size(), '\0');
-    file_.read_exactly(magic.data(), magic.size(), "the version line");
-    if (magic != kAedat4Magic) throw FormatError(path_, 0, "not an AEDAT 4.0 file");
+  /// A file (its version line first) or a DV network stream (the same without it, and without a
+  /// data table: it ends when the server closes it).
+  Aedat4Source(std::unique_ptr<detail::ContainerInput> input, bool network)
+      : input_(std::move(input)), file_(*input_), path_(file_.path()), network_(network) {
+    if (!network_) {
+      std::string magic(kAedat4Magic.size(), '\0');
+      file_.read_exactly(magic.data(), magic.size(), "the version line");
+      if (magic != kAedat4Magic) throw FormatError(path_, 0, "not an AEDAT 4.0 file");
+    }
     std::vector<std::uint8_t> header(4);
+    const std::uint64_t header_at = file_.position();
     file_.read_exactly(header.data(), 4, "the header size");
     const std::uint32_t header_size = detail::load_le32(header.data());
     if (header_size > detail::kMaxDecompressedBytes) throw FormatError(path_, file_.position() - 4, "header size " + std::to_string(header_size));
@@ -90,14 +97,15 @@ class Aedat4Source final : public PacketSource {
     file_.read_exactly(header.data() + 4, header_size, "the header");
     flatbuffers::Verifier verifier(header.data(), header.size());
     if (!aedat4::VerifySizePrefixedIOHeaderBuffer(verifier)) {
-      throw FormatError(path_, kAedat4Magic.size(), "the header is not a valid IOHeader FlatBuffer");
+      throw FormatError(path_, header_at, "the header is not a valid IOHeader FlatBuffer");
     }
     const aedat4::IOHeader* io = aedat4::GetSizePrefixedIOHeader(header.data());
     compression_ = io->compression();
     if (compression_ < aedat4::CompressionType::NONE || compression_ > aedat4::CompressionType::ZSTD_HIGH) {
-      throw FormatError(path_, kAedat4Magic.size(), "unknown compression " + std::to_string(static_cast<int>(compression_)));
+      throw FormatError(path_, header_at, "unknown compression " + std::to_string(static_cast<int>(compression_)));
     }
-    data_end_ = io->dataTablePosition() >= 0 ? static_cast<std::uint64_t>(io->dataTablePosition()) : file_.size();
+    data_end_ = network_ ? std::numeric_limits<std::uint64_t>::max()
+                         : io->dataTablePosition() >= 0 ? static_cast<std::uint64_t>(io->dataTablePosition()) : file_.size();
     const auto streams = parse_streams(io->infoNode() ? io->infoNode()->string_view() : std::string_view());
     for (const auto& [id, stream] : streams) {
       if (stream.type == "EVTS") {
@@ -107,17 +115,21 @@ class Aedat4Source final : public PacketSource {
         break;
       }
     }
-    if (stream_id_ < 0) throw FormatError(path_, kAedat4Magic.size(), "no polarity event stream (EVTS) in the file");
+    if (stream_id_ < 0) throw FormatError(path_, header_at, "no polarity event stream (EVTS) in the header");
   }
 
   bool next(RecordingPacket& packet) override {
     while (file_.position() + 8 <= data_end_) {
       std::uint8_t header[8];
       const std::uint64_t at = file_.position();
-      file_.read_exactly(header, 8, "a packet header");
+      if (network_) {
+        if (!file_.read_exactly_or_end(header, 8, "a packet header")) return false;  // the server closed the stream
+      } else {
+        file_.read_exactly(header, 8, "a packet header");
+      }
       const auto stream = static_cast<std::int32_t>(detail::load_le32(header));
       const std::uint32_t size = detail::load_le32(header + 4);
-      if (size > detail::kMaxDecompressedBytes || file_.position() + size > data_end_) {
+      if (size > detail::kMaxDecompressedBytes || size > data_end_ - file_.position()) {
         throw FormatError(path_, at, "packet of " + std::to_string(size) + " bytes does not fit in the file");
       }
       if (stream != stream_id_) {
@@ -150,6 +162,7 @@ class Aedat4Source final : public PacketSource {
     return "AEDAT 4.0, stream " + std::to_string(stream_id_) + " (polarity events, " + compression_name() + ")";
   }
   [[nodiscard]] double progress() const override {
+    if (network_) return 0.0;
     return data_end_ == 0 ? 1.0 : static_cast<double>(file_.position()) / static_cast<double>(data_end_);
   }
   [[nodiscard]] std::uint64_t skipped_packets() const override { return skipped_; }
@@ -169,8 +182,10 @@ class Aedat4Source final : public PacketSource {
     }
   }
 
-  detail::ContainerFile file_;
+  std::unique_ptr<detail::ContainerInput> input_;
+  detail::ContainerInput& file_;
   std::string path_;
+  bool network_;
   std::uint64_t data_end_ = 0;
   aedat4::CompressionType compression_ = aedat4::CompressionType::NONE;
   int stream_id_ = -1;
@@ -182,6 +197,12 @@ class Aedat4Source final : public PacketSource {
 
 }  // namespace
 
-std::unique_ptr<PacketSource> open_aedat4(const std::filesystem::path& path) { return std::make_unique<Aedat4Source>(path); }
+std::unique_ptr<PacketSource> open_aedat4(const std::filesystem::path& path) {
+  return std::make_unique<Aedat4Source>(std::make_unique<detail::ContainerFile>(path, "AEDAT 4"), false);
+}
+
+std::unique_ptr<PacketSource> open_aedat4_stream(std::unique_ptr<ByteSource> bytes) {
+  return std::make_unique<Aedat4Source>(std::make_unique<detail::ContainerStream>(std::move(bytes)), true);
+}
 
 }  // namespace evldt

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "evldt/containers/aedat4.hpp"
 #include "evldt/containers/hdf5_events.hpp"
 #include "evldt/containers/packet_source.hpp"
 #include "evldt/events/event_stream_reader.hpp"
@@ -39,34 +40,33 @@ class RecordingSource final : public EventSource {
 
 class ReconnectingSource final : public EventSource {
  public:
-  ReconnectingSource(std::function<std::unique_ptr<ByteSource>()> connect, std::optional<EventFormat> format,
-                     const std::atomic<bool>& stop)
-      : connect_(std::move(connect)), format_(format), stop_(stop) {
+  ReconnectingSource(std::function<std::unique_ptr<EventSource>()> open, const std::atomic<bool>& stop)
+      : open_(std::move(open)), stop_(stop) {
     if (!connect_once()) throw std::runtime_error("stopped before a connection was made");
-    geometry_ = reader_->geometry();
-    name_ = reader_->name() + " (" + std::string(format_name(reader_->format())) + ", live, reconnecting)";
+    geometry_ = current_->geometry();
+    name_ = current_->name() + " (reconnecting)";
   }
   bool read(EventBatch& batch) override {
     for (;;) {
-      if (!reader_) {
+      if (!current_) {
         if (!connect_once()) return false;  // stopped
         ++reconnects_;
         spdlog::info("{}: connected again ({} reconnects)", name_, reconnects_);
       }
       try {
-        if (reader_->read(batch)) return true;
+        if (current_->read(batch)) return true;
         spdlog::warn("{}: the stream ended; connecting again", name_);
       } catch (const FormatError& error) {  // cut inside a word or packet: the events before it were read
         spdlog::warn("{}: {}; connecting again", name_, error.what());
       }
-      retire_reader();
+      retire_current();
       if (stop_.load()) return false;
     }
   }
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return geometry_; }
   [[nodiscard]] DecodeCounts decode_counts() const override {
     DecodeCounts counts = retired_counts_;
-    if (reader_) counts += reader_->counts();
+    if (current_) counts += current_->decode_counts();
     return counts;
   }
   [[nodiscard]] double progress() const override { return 0.0; }
@@ -81,7 +81,7 @@ class ReconnectingSource final : public EventSource {
     std::chrono::milliseconds wait = kFirstWait;
     for (std::uint64_t attempt = 1; !stop_.load(); ++attempt) {
       try {
-        reader_ = std::make_unique<EventStreamReader>(connect_(), format_, "");
+        current_ = open_();
         return true;
       } catch (const std::runtime_error& error) {  // no server yet, or a stream that broke in its header
         if (std::has_single_bit(attempt)) spdlog::warn("{} (attempt {}; trying again)", error.what(), attempt);
@@ -93,15 +93,14 @@ class ReconnectingSource final : public EventSource {
     }
     return false;
   }
-  void retire_reader() {
-    retired_counts_ += reader_->counts();
-    reader_.reset();
+  void retire_current() {
+    retired_counts_ += current_->decode_counts();
+    current_.reset();
   }
 
-  std::function<std::unique_ptr<ByteSource>()> connect_;
-  std::optional<EventFormat> format_;
+  std::function<std::unique_ptr<EventSource>()> open_;
   const std::atomic<bool>& stop_;
-  std::unique_ptr<EventStreamReader> reader_;
+  std::unique_ptr<EventSource> current_;
   std::optional<SensorSize> geometry_;
   DecodeCounts retired_counts_;
   std::uint64_t reconnects_ = 0;
@@ -109,9 +108,9 @@ class ReconnectingSource final : public EventSource {
 
 class ContainerSource final : public EventSource {
  public:
-  ContainerSource(std::unique_ptr<PacketSource> packets, const std::filesystem::path& path)
-      : path_(path.string()), reader_(std::move(packets), path.string()) {
-    name_ = path_ + " (" + reader_.source().description() + ")";
+  ContainerSource(std::unique_ptr<PacketSource> packets, const std::string& path, bool live = false)
+      : path_(path), reader_(std::move(packets), path), live_(live) {
+    name_ = path_ + " (" + reader_.source().description() + (live ? ", live" : "") + ")";
   }
   ~ContainerSource() override {
     if (const std::uint64_t skipped = reader_.source().skipped_packets()) {
@@ -122,6 +121,7 @@ class ContainerSource final : public EventSource {
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return geometry_; }
   [[nodiscard]] DecodeCounts decode_counts() const override { return reader_.counts(); }
   [[nodiscard]] double progress() const override { return reader_.source().progress(); }
+  [[nodiscard]] bool live() const override { return live_; }
   /// Reads ahead to the first packet where the container has no size (or camera name) of its own.
   void learn_geometry() {
     geometry_ = reader_.geometry();
@@ -132,6 +132,7 @@ class ContainerSource final : public EventSource {
  private:
   std::string path_;
   PacketEventReader reader_;
+  bool live_;
   std::optional<SensorSize> geometry_;
 };
 
@@ -277,9 +278,15 @@ std::unique_ptr<EventSource> open_stream(std::unique_ptr<ByteSource> bytes, std:
   return std::make_unique<RecordingSource>(std::make_unique<EventStreamReader>(std::move(bytes), format, extension), true);
 }
 
-std::unique_ptr<EventSource> open_reconnecting_stream(std::function<std::unique_ptr<ByteSource>()> connect,
-                                                      std::optional<EventFormat> format, const std::atomic<bool>& stop) {
-  return std::make_unique<ReconnectingSource>(std::move(connect), format, stop);
+std::unique_ptr<EventSource> open_dv_stream(std::unique_ptr<ByteSource> bytes) {
+  const std::string name = bytes->name();
+  auto source = std::make_unique<ContainerSource>(open_aedat4_stream(std::move(bytes)), name, true);
+  source->learn_geometry();
+  return source;
+}
+
+std::unique_ptr<EventSource> open_reconnecting(std::function<std::unique_ptr<EventSource>()> open, const std::atomic<bool>& stop) {
+  return std::make_unique<ReconnectingSource>(std::move(open), stop);
 }
 
 std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label) {

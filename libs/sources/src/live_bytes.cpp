@@ -11,6 +11,7 @@
 #include <sys/inotify.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 namespace evldt {
@@ -104,6 +105,28 @@ std::size_t TcpBytes::read(std::span<std::uint8_t> into) {
   setsockopt(fd(), IPPROTO_TCP, TCP_QUICKACK, &on, sizeof on);  // not sticky: again after every read
   return got;
 }
+
+namespace {
+
+int connect_unix(const std::string& path) {
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (path.empty() || path.size() >= sizeof address.sun_path) throw std::runtime_error("'" + path + "' is not a Unix socket path");
+  path.copy(address.sun_path, path.size());
+  const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) throw system_error("socket");
+  if (connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
+    const std::runtime_error error = system_error("cannot connect to unix://" + path);
+    close(fd);
+    throw error;
+  }
+  return fd;
+}
+
+}  // namespace
+
+UnixSocketBytes::UnixSocketBytes(const std::string& path, const std::atomic<bool>& stop)
+    : DescriptorBytes(connect_unix(path), "unix://" + path, stop, true) {}
 
 FollowedFileBytes::FollowedFileBytes(const std::filesystem::path& path, std::chrono::duration<double> idle,
                                      const std::atomic<bool>& stop)

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "evldt/containers/packet_source.hpp"
+#include "evldt/events/byte_source.hpp"
 
 namespace evldt {
 
@@ -19,5 +20,9 @@ inline constexpr std::string_view kAedat4Magic = "#!AER-DAT4.0\r\n";
 /// Throws FormatError naming the file and byte offset for a header that cannot be read or a file
 /// without a polarity event stream.
 std::unique_ptr<PacketSource> open_aedat4(const std::filesystem::path& path);
+/// DV's network output (dv-runtime's net-tcp-server and net-socket-server, dv-processing's
+/// NetworkWriter): an AEDAT 4.0 file's layout without its version line and data table, from the
+/// size-prefixed IOHeader on; it ends when the server closes it at a packet boundary.
+std::unique_ptr<PacketSource> open_aedat4_stream(std::unique_ptr<ByteSource> bytes);
 
 }  // namespace evldt

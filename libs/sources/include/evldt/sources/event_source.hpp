@@ -55,13 +55,14 @@ std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, s
 /// header. Blocks until the header has come.
 std::unique_ptr<EventSource> open_stream(std::unique_ptr<ByteSource> bytes, std::optional<EventFormat> format,
                                          std::string_view extension);
-/// A live stream that is connected again when it ends or is cut (a camera server restarting): each
-/// connection from `connect` (which throws std::runtime_error when it cannot be made) is read as a
-/// stream of its own (header, then data); between attempts it waits, without using the CPU, 0.1 s
-/// doubling up to 2 s. Connects before it returns; ends only when `stop` is set (throws
-/// std::runtime_error if stopped before the first connection).
-std::unique_ptr<EventSource> open_reconnecting_stream(std::function<std::unique_ptr<ByteSource>()> connect,
-                                                      std::optional<EventFormat> format, const std::atomic<bool>& stop);
+/// DV's AEDAT 4.0 network stream (see open_aedat4_stream), read as it comes.
+std::unique_ptr<EventSource> open_dv_stream(std::unique_ptr<ByteSource> bytes);
+/// A live source opened again when it ends or is cut (a camera server restarting): each one from
+/// `open` (which throws std::runtime_error when it cannot connect) is read as a stream of its own
+/// (header, then data); between attempts it waits, without using the CPU, 0.1 s doubling up to
+/// 2 s. Connects before it returns; ends only when `stop` is set (throws std::runtime_error if
+/// stopped before the first connection).
+std::unique_ptr<EventSource> open_reconnecting(std::function<std::unique_ptr<EventSource>()> open, const std::atomic<bool>& stop);
 /// A scene run through the event simulator; `label` names it in logs.
 std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label);
 

@@ -56,6 +56,14 @@ class TcpBytes final : public DescriptorBytes {
   std::size_t read(std::span<std::uint8_t> into) override;
 };
 
+/// A Unix stream socket a server listens on (DV's net-socket-server): "unix:///run/dv.sock" ->
+/// the path; connected at construction (std::runtime_error naming it if it cannot be). Ends when the
+/// server closes the connection.
+class UnixSocketBytes final : public DescriptorBytes {
+ public:
+  UnixSocketBytes(const std::string& path, const std::atomic<bool>& stop);
+};
+
 /// A file that a recorder may still be writing: reads what is there, then waits for more (inotify)
 /// and ends once it has not grown for `idle` (or on stop). A file that shrinks or is replaced (a new
 /// file under the name) is an error: std::runtime_error, naming it.
