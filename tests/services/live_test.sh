@@ -2,8 +2,10 @@
 # Live inputs end to end (issue 26), real processes over UDP multicast on loopback (ttl=0): a RAW
 # recording fed to evldt-camera in pieces of random size with pauses, as a driver or recorder
 # would, through each live path (standard input, a TCP stream, a file followed while it is
-# written) -> evldt-lines -> evldt-viz. Every event of the recording must be published, every
-# batch received by evldt-lines and evldt-viz, and a segment list must include the last batch.
+# written, and DV's AEDAT 4.0 network output of a real DVXplorer recording with a server restart
+# in the middle: skipped with a message when ../shared is absent) -> evldt-lines -> evldt-viz.
+# Every event of the recording must be published, every batch received by evldt-lines and
+# evldt-viz, and a segment list must include the last batch.
 # Usage: live_test.sh BUILD_DIR SOURCE_DIR
 set -uo pipefail
 build=$1
@@ -56,10 +58,11 @@ elif mode == "append":
             out.flush()
 PY
 
-live_path() {  # live_path NAME CAMERA_ARGS...: the camera on a live input, fed by $feed_pid's writer
+sensor=(--width 240 --height 180)  # evldt-lines is given the camera's size, as a deployment does
+live_path() {  # live_path NAME COMMAND...: the camera on a live input (COMMAND runs it), lines and viz listening
   local name=$1
   shift
-  "$lines" --lcm-url "$url" --log-period-s 0 --width 240 --height 180 >"$work/$name.lines.out" 2>"$work/$name.lines.err" &
+  "$lines" --lcm-url "$url" --log-period-s 0 "${sensor[@]}" >"$work/$name.lines.out" 2>"$work/$name.lines.err" &
   local lines_pid=$!
   "$viz" --lcm-url "$url" --headless --png-dir "$work/$name.png" --png-period-s 0.5 >"$work/$name.viz.out" 2>"$work/$name.viz.err" &
   local viz_pid=$!
@@ -99,5 +102,31 @@ live_path tcp "$camera" "tcp://127.0.0.1:$(cat "$work/port")" --lcm-url "$url" -
 python3 "$work/feed.py" "$recording" append "$work/growing.raw" &
 live_path follow "$camera" --follow "$work/growing.raw" --follow-idle-s 1 --lcm-url "$url" -q
 check "follow: the followed file is the whole recording" cmp -s "$work/growing.raw" "$recording"
+
+# 4. DV's AEDAT 4.0 network output, from a real DVXplorer recording; the server goes away in the
+#    middle and comes back (--reconnect), and every event must arrive once.
+dv_recording=$source_dir/../shared/real/dvxplorer_person.aedat4
+if [[ -f $dv_recording ]]; then
+  "$camera" "$dv_recording" --lcm-url "$url" --speed 0 -q >"$work/dv_reference.out" 2>"$work/dv_reference.err"
+  events=$(field "$work/dv_reference.out" "events +")
+  sensor=(--width 320 --height 240)
+  rm -f "$work/dv_port"
+  "$build/tests/dv_stream_server" "$dv_recording" "$work/dv_port" split &
+  dv_server_pid=$!
+  wait_until "the DV test server to listen" test -s "$work/dv_port"
+  # The camera reconnects until stopped: stop it once the server has served both connections.
+  live_dv() {
+    "$camera" "tcp://127.0.0.1:$(cat "$work/dv_port")" --format aedat4 --reconnect --lcm-url "$url" -q &
+    local camera_pid=$!
+    wait "$dv_server_pid"
+    sleep 1
+    kill -INT "$camera_pid"
+    wait "$camera_pid"
+  }
+  live_path dv live_dv
+  check "dv: the camera connected again after the server went away" grep -qP "live input +[1-9][0-9]* reconnects" "$work/dv.camera.out"
+else
+  echo "skipped: DV network stream ($dv_recording is absent: ../shared is not beside the project)"
+fi
 
 finish
