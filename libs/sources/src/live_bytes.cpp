@@ -135,7 +135,11 @@ FollowedFileBytes::FollowedFileBytes(const std::filesystem::path& path, std::chr
   fd_ = open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) throw system_error("cannot open event file '" + name_ + "'");
   struct stat info{};
-  if (fstat(fd_, &info) != 0) throw system_error("cannot stat '" + name_ + "'");
+  if (fstat(fd_, &info) != 0) {
+    const std::runtime_error error = system_error("cannot stat '" + name_ + "'");
+    close(fd_);  // the destructor does not run for a constructor that throws
+    throw error;
+  }
   device_ = info.st_dev;
   inode_ = info.st_ino;
   watch_fd_ = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
