@@ -2,7 +2,7 @@
 # Live inputs end to end (issue 26), real processes over UDP multicast on loopback (ttl=0): a RAW
 # recording fed to evldt-camera in pieces of random size with pauses, as a driver or recorder
 # would, through each live path (standard input, a TCP stream, a file followed while it is
-# written, and DV's AEDAT 4.0 network output of a real DVXplorer recording with a server restart
+# written, libcaer's AEDAT 3.1 network stream, and DV's AEDAT 4.0 network output of a real DVXplorer recording with a server restart
 # in the middle: skipped with a message when ../shared is absent) -> evldt-lines -> evldt-viz.
 # Every event of the recording must be published, every batch received by evldt-lines and
 # evldt-viz, and a segment list must include the last batch.
@@ -105,7 +105,13 @@ python3 "$work/feed.py" "$recording" append "$work/growing.raw" &
 live_path follow "$camera" --follow "$work/growing.raw" --follow-idle-s 1 --lcm-url "$url" -q
 check "follow: the followed file is the whole recording" cmp -s "$work/growing.raw" "$recording"
 
-# 4. DV's AEDAT 4.0 network output, from a real DVXplorer recording; the server goes away in the
+# 4. cAER / libcaer's AEDAT 3.1 network output of the same recording (it names no sensor size).
+rm -f "$work/aedat31_port"
+"$build/tests/aedat31_stream_server" "$recording" "$work/aedat31_port" &
+wait_until "the AEDAT 3.1 test server to listen" test -s "$work/aedat31_port"
+live_path aedat31 "$camera" "tcp://127.0.0.1:$(cat "$work/aedat31_port")" --width 240 --height 180 --lcm-url "$url" -q
+
+# 5. DV's AEDAT 4.0 network output, from a real DVXplorer recording; the server goes away in the
 #    middle and comes back (--reconnect), and every event must arrive once.
 dv_recording=$source_dir/../shared/real/dvxplorer_person.aedat4
 if [[ -f $dv_recording ]]; then
