@@ -47,7 +47,8 @@ std::unique_ptr<EventSource> SourceOptions::open(Timestamp backwards_slack_us, c
       int{!recording_.empty()} + int{!followed_.empty()} + int{simulator_.scene_selected()} + int{!video_.empty()};
   if (selected != 1) {
     throw std::invalid_argument(
-        "give exactly one source: a recording file, '-', tcp://HOST:PORT, --follow FILE, --scene NAME or --from-video FILE|INDEX");
+        "give exactly one source: a recording file, '-', tcp://HOST:PORT, unix:///PATH, --follow FILE, --scene NAME or "
+        "--from-video FILE|INDEX");
   }
   if (simulator_.scene_selected()) return open_scene(simulator_.scene(), simulator_.config(), simulator_.scene_name());
   if (!video_.empty()) {
