@@ -4,9 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include <arpa/inet.h>
 #include <fcntl.h>
-#include <netinet/in.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -19,13 +17,15 @@
 #include <thread>
 #include <vector>
 
-#include "aedat4_header_generated.h"
 #include "evldt/events/event_stream_reader.hpp"
 #include "evldt/events/event_writer.hpp"
 #include "evldt/sim/scenes.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sources/event_source.hpp"
 #include "evldt/sources/live_bytes.hpp"
+#include "support/aedat31_network.hpp"
+#include "support/dv_framing.hpp"
+#include "support/loopback_server.hpp"
 #include "support/temp_dir.hpp"
 
 namespace evldt {
@@ -248,36 +248,25 @@ TEST(DescriptorBytes, WaitsWithoutCpuAndStopEndsTheWait) {
 /// A TCP server on a loopback port of its own; serve() sends bytes to the first client, then closes.
 class TestServer {
  public:
-  TestServer() {
-    listener_ = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    EXPECT_EQ(bind(listener_, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
-    socklen_t size = sizeof address;
-    getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &size);
-    port_ = ntohs(address.sin_port);
-    EXPECT_EQ(listen(listener_, 1), 0);
-  }
+  TestServer() : listener_(test_support::listen_on_loopback()) { EXPECT_GE(listener_.fd, 0); }
   ~TestServer() {
     if (thread_.joinable()) thread_.join();
-    close(listener_);
+    close(listener_.fd);
   }
   void serve(std::vector<std::uint8_t> bytes) { serve_each({std::move(bytes)}); }
   /// One stream to each client, in the order they connect.
   void serve_each(std::vector<std::vector<std::uint8_t>> streams) {
     thread_ = std::thread([this, streams = std::move(streams)] {
       for (const auto& bytes : streams) {
-        const int client = accept(listener_, nullptr, nullptr);
+        const int client = accept(listener_.fd, nullptr, nullptr);
         if (client >= 0) write_in_pieces(client, bytes, 11u);
       }
     });
   }
-  [[nodiscard]] std::string url() const { return "tcp://127.0.0.1:" + std::to_string(port_); }
+  [[nodiscard]] std::string url() const { return "tcp://127.0.0.1:" + std::to_string(listener_.port); }
 
  private:
-  int listener_ = -1;
-  int port_ = 0;
+  test_support::LoopbackListener listener_;
   std::thread thread_;
 };
 
@@ -315,41 +304,12 @@ TEST(TcpBytes, AStreamCutInsideAWordKeepsTheEventsBeforeIt) {
   EXPECT_TRUE(got == expected) << "the events before the cut, as from the same bytes in a file";
 }
 
-void append_le(std::vector<std::uint8_t>& bytes, std::uint64_t value, int size) {
-  for (int i = 0; i < size; ++i) bytes.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
-}
-
-/// The events as cAER streams them over TCP: libcaer's network header (network.h), then AEDAT 3.1
-/// polarity packets of 500 events (iniVation's AEDAT 3.1 description).
-std::vector<std::uint8_t> aedat31_network_stream(const std::vector<Event>& events) {
-  std::vector<std::uint8_t> bytes;
-  append_le(bytes, 0x1D378BC90B9A6658, 8);  // magic
-  append_le(bytes, 0, 8);                   // sequence number
-  bytes.push_back(1);                       // version
-  bytes.push_back(0);                       // format
-  append_le(bytes, 1, 2);                   // source id
-  for (std::size_t begin = 0; begin < events.size(); begin += 500) {
-    const std::size_t count = std::min<std::size_t>(500, events.size() - begin);
-    append_le(bytes, 1, 2);  // polarity events
-    append_le(bytes, 1, 2);  // source
-    for (const std::uint64_t field : {8u, 4u, 0u, static_cast<unsigned>(count), static_cast<unsigned>(count), static_cast<unsigned>(count)}) {
-      append_le(bytes, field, 4);  // event size, timestamp offset, overflow, capacity, number, valid
-    }
-    for (std::size_t i = begin; i < begin + count; ++i) {
-      const Event& e = events[i];
-      append_le(bytes, std::uint64_t{e.x} << 17 | std::uint64_t{e.y} << 2 | (e.p > 0 ? 2u : 0u) | 1u, 4);
-      append_le(bytes, static_cast<std::uint64_t>(e.t), 4);
-    }
-  }
-  return bytes;
-}
-
 TEST(TcpBytes, AnAedat31NetworkStreamInRandomPiecesGivesItsEvents) {
   TempDir dir;
   EventStreamReader finished(simulated_recording(dir));
   const std::vector<Event> expected = all_events(finished);
   TestServer server;
-  server.serve(aedat31_network_stream(expected));
+  server.serve(test_support::aedat31_network_stream(expected));
   const std::atomic<bool> never{false};
   EventStreamReader streamed(std::make_unique<TcpBytes>(TcpAddress::parse(server.url()), never), std::nullopt, "");
   EXPECT_EQ(streamed.format(), EventFormat::Aedat31Network);  // told by the network header's magic number
@@ -364,8 +324,8 @@ TEST(ReconnectingStream, AServerThatRestartsMidStreamDeliversEveryEventOnce) {
   TestServer server;
   // The server goes away after the first half and comes back with a stream of its own (its network
   // header again) that goes on from where the first ended.
-  server.serve_each({aedat31_network_stream({expected.begin(), expected.begin() + static_cast<std::ptrdiff_t>(half)}),
-                     aedat31_network_stream({expected.begin() + static_cast<std::ptrdiff_t>(half), expected.end()})});
+  server.serve_each({test_support::aedat31_network_stream(std::span(expected).first(half)),
+                     test_support::aedat31_network_stream(std::span(expected).subspan(half))});
   std::atomic<bool> stop{false};
   const TcpAddress address = TcpAddress::parse(server.url());
   const auto source =
@@ -404,39 +364,6 @@ TEST(ReconnectingStream, WaitsForAServerNotYetUpAndStopEndsTheWait) {
   stopper.join();
 }
 
-/// An AEDAT 4.0 file as DV's network output streams it: the size-prefixed IOHeader and the packets,
-/// without the version line and the data table; `first`, `last`: the packets to send ([first, last)).
-struct Aedat4File {
-  std::vector<std::uint8_t> header;                          // size prefix and IOHeader
-  std::vector<std::pair<std::size_t, std::size_t>> packets;  // offset and length of each, header included
-  std::vector<std::uint8_t> bytes;
-
-  explicit Aedat4File(const std::filesystem::path& path) : bytes(file_bytes(path)) {
-    const std::size_t at = std::string_view("#!AER-DAT4.0\r\n").size();
-    const std::uint32_t size = load_le32(bytes.data() + at);
-    header.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at), bytes.begin() + static_cast<std::ptrdiff_t>(at + 4 + size));
-    const auto* io = aedat4::GetSizePrefixedIOHeader(header.data());
-    const auto end = io->dataTablePosition() >= 0 ? static_cast<std::size_t>(io->dataTablePosition()) : bytes.size();
-    for (std::size_t packet = at + 4 + size; packet + 8 <= end;) {
-      const std::size_t length = 8 + load_le32(bytes.data() + packet + 4);
-      packets.emplace_back(packet, length);
-      packet += length;
-    }
-  }
-  [[nodiscard]] std::vector<std::uint8_t> stream(std::size_t first, std::size_t last) const {
-    std::vector<std::uint8_t> out = header;
-    for (std::size_t i = first; i < last; ++i) {
-      const auto [offset, length] = packets[i];
-      out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(offset), bytes.begin() + static_cast<std::ptrdiff_t>(offset + length));
-    }
-    return out;
-  }
-  static std::uint32_t load_le32(const std::uint8_t* p) {
-    return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16 |
-           static_cast<std::uint32_t>(p[3]) << 24;
-  }
-};
-
 TEST(DvNetworkStream, ARealRecordingStreamedWithADisconnectArrivesOnceEveryEvent) {
   const auto recording = real_recording("dvxplorer_person.aedat4");
   if (!std::filesystem::exists(recording)) GTEST_SKIP() << "no " << recording << " (../shared is absent)";
@@ -451,12 +378,12 @@ TEST(DvNetworkStream, ARealRecordingStreamedWithADisconnectArrivesOnceEveryEvent
     }
   }
   ASSERT_FALSE(expected.empty());
-  const Aedat4File file(recording);
-  ASSERT_GT(file.packets.size(), 2u);
-  const std::size_t middle = file.packets.size() / 2;
+  const test_support::DvFraming file(recording);
+  ASSERT_GT(file.packets(), 2u);
+  const std::size_t middle = file.packets() / 2;
   TestServer server;
   // The server goes away in the middle and comes back, sending its header again, then the rest.
-  server.serve_each({file.stream(0, middle), file.stream(middle, file.packets.size())});
+  server.serve_each({file.stream(0, middle), file.stream(middle, file.packets())});
   std::atomic<bool> stop{false};
   const TcpAddress address = TcpAddress::parse(server.url());
   const auto source = open_reconnecting([&] { return open_dv_stream(std::make_unique<TcpBytes>(address, stop)); }, stop);
@@ -475,8 +402,8 @@ TEST(DvNetworkStream, ARealRecordingStreamedWithADisconnectArrivesOnceEveryEvent
 TEST(DvNetworkStream, AUnixSocketStreamCutInsideAPacketKeepsTheEventsBeforeIt) {
   const auto recording = real_recording("dvxplorer_person.aedat4");
   if (!std::filesystem::exists(recording)) GTEST_SKIP() << "no " << recording << " (../shared is absent)";
-  const Aedat4File file(recording);
-  std::vector<std::uint8_t> cut = file.stream(0, file.packets.size());
+  const test_support::DvFraming file(recording);
+  std::vector<std::uint8_t> cut = file.stream(0, file.packets());
   cut.resize(cut.size() - 3);  // inside the last packet
   TempDir dir;
   const std::string path = dir.file("dv.sock").string();

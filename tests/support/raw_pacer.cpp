@@ -5,9 +5,6 @@
 // appended to a file.
 // Usage: raw_pacer FILE SPEED stdout|tcp PORT_FILE|append OUT_FILE [PIECE_BYTES]
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -21,6 +18,7 @@
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_stream_reader.hpp"
 #include "evldt/transport/pacer.hpp"
+#include "support/loopback_server.hpp"
 
 namespace {
 
@@ -41,18 +39,10 @@ int open_output(const std::string& mode, const std::string& target) {
     return file ? fileno(file) : -1;
   }
   if (mode != "tcp") return -1;
-  const int listener = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t size = sizeof address;
-  if (bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 || listen(listener, 1) != 0 ||
-      getsockname(listener, reinterpret_cast<sockaddr*>(&address), &size) != 0) {
-    return -1;
-  }
-  std::ofstream(target + ".tmp") << ntohs(address.sin_port);
-  std::filesystem::rename(target + ".tmp", target);
-  return accept(listener, nullptr, nullptr);
+  const evldt::test_support::LoopbackListener listener = evldt::test_support::listen_on_loopback();
+  if (listener.fd < 0) return -1;
+  evldt::test_support::write_port_file(listener.port, target);
+  return accept(listener.fd, nullptr, nullptr);
 }
 
 }  // namespace
