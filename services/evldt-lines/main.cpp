@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
         "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
         "  loops     %llu detection rounds, %llu tracking rounds\n"
         "  output    %llu lines created, %llu segment lists published\n"
-        "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches)\n",
+        "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches); settled, from 1 s after\n"
+        "            the first batch: median %.1f ms, p99 %.1f ms (%u batches)\n",
         static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),
         static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.sequence.resyncs),
         static_cast<unsigned long long>(t.receiver.invalid_messages),
@@ -86,7 +87,8 @@ int main(int argc, char** argv) {
         static_cast<unsigned long long>(t.filtered.background_activity), static_cast<unsigned long long>(t.filtered.refractory),
         static_cast<unsigned long long>(t.filtered.anti_flicker), static_cast<unsigned long long>(t.detect_rounds),
         static_cast<unsigned long long>(t.track_rounds), static_cast<unsigned long long>(t.lines_created),
-        static_cast<unsigned long long>(t.lists_published), t.latency.median_ms, t.latency.p99_ms, t.latency.samples);
+        static_cast<unsigned long long>(t.lists_published), t.latency.median_ms, t.latency.p99_ms, t.latency.samples,
+        t.settled_latency.median_ms, t.settled_latency.p99_ms, t.settled_latency.samples);
     return 0;
   });
 }

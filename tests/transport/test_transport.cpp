@@ -554,6 +554,23 @@ TEST(LatencyTracker, ForgetsTheOldestBeyondCapacity) {
   EXPECT_EQ(tracker.take_summary().samples, 2u);  // batches 3 and 4 only
 }
 
+TEST(LatencyTracker, SettledFiguresLeaveOutTheStreamsFirstSecond) {
+  LatencyTracker tracker(64, 100);
+  // A slow start: the first second's batches wait 30 ms for their list, the later ones 2 ms.
+  for (std::int64_t k = 0; k < 20; ++k) {
+    const std::int64_t publish = k * 100'000;  // 0.1 s apart
+    tracker.batch_stored(k, publish, k * 100);
+    tracker.list_published(k * 100, publish + (publish < LatencyTracker::kSettleUs ? 30'000 : 2'000));
+  }
+  const LatencySummary run = tracker.run_summary();
+  const LatencySummary settled = tracker.settled_summary();
+  EXPECT_EQ(run.samples, 20u);
+  EXPECT_NEAR(run.p99_ms, 30.1, 1e-9);
+  EXPECT_EQ(settled.samples, 10u);  // published 1.0 s .. 1.9 s after the first
+  EXPECT_NEAR(settled.median_ms, 2.1, 1e-9);
+  EXPECT_NEAR(settled.p99_ms, 2.1, 1e-9);
+}
+
 // ---- receiving end -----------------------------------------------------------------------------
 
 TEST(EventBatchReceiver, AdoptsSensorCountsLossAndRefusesForeignPayloads) {

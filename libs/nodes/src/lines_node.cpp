@@ -316,6 +316,7 @@ LinesNodeTotals LinesNode::totals() const {
     totals.track_rounds = retired_.track_rounds;
     totals.lines_created = retired_.lines_created;
     totals.latency = latency_.run_summary();
+    totals.settled_latency = latency_.settled_summary();
   }
   if (engine) {
     const EngineCounters counters = engine->counters();

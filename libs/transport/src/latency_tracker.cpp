@@ -21,6 +21,7 @@ LatencyTracker::LatencyTracker(std::size_t pending_capacity, std::size_t sample_
     : ring_(std::max<std::size_t>(pending_capacity, 1)), statistics_(sample_capacity) {}
 
 void LatencyTracker::batch_stored(std::int64_t seq, std::int64_t publish_utime, Timestamp newest_event_us) {
+  if (!first_utime_) first_utime_ = publish_utime;
   if (count_ == ring_.size()) {  // forget the oldest
     head_ = (head_ + 1) % ring_.size();
     --count_;
@@ -33,7 +34,9 @@ LatencyTracker::Included LatencyTracker::list_published(Timestamp lattice_us, st
   // Batches arrive in event-time order, so the included ones are a prefix of the ring.
   while (count_ > 0 && ring_[head_].newest_event_us <= lattice_us) {
     const Pending& batch = ring_[head_];
-    statistics_.add(static_cast<double>(now_utime - batch.utime) * 1e-3);
+    const double latency_ms = static_cast<double>(now_utime - batch.utime) * 1e-3;
+    statistics_.add(latency_ms);
+    if (batch.utime - *first_utime_ >= kSettleUs) settled_.add(latency_ms);
     newest_ = {batch.seq, batch.utime};
     head_ = (head_ + 1) % ring_.size();
     --count_;

@@ -55,6 +55,7 @@ struct LinesNodeTotals {
   std::uint64_t lists_published = 0;
   std::uint64_t engine_restarts = 0;  ///< the camera restarted (new epoch): the lattice began afresh
   LatencySummary latency;             ///< batch publish -> first list including it, since the last camera (re)start
+  LatencySummary settled_latency;     ///< the same, of the batches published 1 s or more after the first (LatencyTracker)
 };
 
 class LinesNode {
