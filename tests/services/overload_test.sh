@@ -86,7 +86,7 @@ kill -INT "$lines_pid"
 wait "$lines_pid"
 cat "$work/slow.out"
 shed=$(field "$work/slow.out" 'shed')
-p99=$(grep -oP 'p99 \K[0-9.]+' "$work/slow.out")
+p99=$(grep -oP 'p99 \K[0-9.]+' "$work/slow.out" | head -1)
 check "the stalled evldt-lines shed batches that queued past ${budget_ms} ms ($shed)" test "${shed:-0}" -gt 0
 check "... counted apart from losses: none lost" grep -qP "batches +$batches received, 0 lost" "$work/slow.out"
 check "... in its statistics messages too" \
@@ -95,7 +95,7 @@ check "... in its statistics messages too" \
 # before a stall wait it out. The median is asserted; the p99 is printed (19.6 ms in quiet runs, but
 # about 300 ms in runs on a busier machine, where about half the stalled batches were stored: not
 # explained yet, see the issue note).
-median=$(grep -oP 'median \K[0-9.]+' "$work/slow.out")
+median=$(grep -oP 'median \K[0-9.]+' "$work/slow.out" | head -1)
 echo "latency of what it stored: median $median ms, p99 $p99 ms"
 check "the latency of what it stored stays within the budget (median $median ms < $budget_ms ms)" \
   awk -v m="${median:-1e9}" -v b="$budget_ms" 'BEGIN { exit !(m < b) }'
