@@ -13,7 +13,7 @@ eval=$build/tools/evldt-eval/evldt-eval
 mkdir -p "$out"
 printed_header=0
 for filters in default none; do
-  for scene in three-lines-fast circle-board boxes-6dof multi-speed monitor-hd noisy-boxes flicker-lamps night-boxes boxes-10s poster-10s; do
+  for scene in three-lines-fast circle-board boxes-6dof multi-speed monitor-hd noisy-boxes flicker-lamps night-boxes boxes-10s poster-10s tag-board; do
     step=10000
     [[ $scene == monitor-hd ]] && step=20000  # 1280x720: score every 20 ms to keep the run short
     name=$scene

@@ -99,6 +99,17 @@ in_process_whole_idf1=$(awk '$2 == "whole" { print $NF }' "$work/in_process_both
 awk -v a="$whole_idf1" -v b="$in_process_whole_idf1" 'BEGIN { d = a - b; exit !(d < 0.01 && d > -0.01) }' ||
   fail "whole lines from the file ($whole_idf1) and in process ($in_process_whole_idf1) differ"
 echo "ok: evaluation of ground truth against itself is perfect; file and in-process scores agree: $(cat "$work/in_process.txt")"
+# The whole lines' support by the segments (no ground truth needed): from the two CSVs as in process.
+"$eval" --segments "$work/p.csv" --whole-lines "$work/whole.csv" --json "$work/support.json" >"$work/support.txt"
+file_support=$(grep -oP 'support of whole.csv: \K[0-9.]+' "$work/support.txt")
+in_process_support=$(grep -oP 'support of boxes-6dof whole: \K[0-9.]+' "$work/in_process_both.txt")
+awk -v a="$file_support" -v b="$in_process_support" 'BEGIN { d = a - b; exit !(a > 0.5 && a <= 1 && d < 0.01 && d > -0.01) }' ||
+  fail "whole-line support from the files ($file_support) and in process ($in_process_support) differ"
+tr -d ' \n' <"$work/support.json" | grep -qP '"whole_line_support":\{"steps":4[01],"lines":[1-9]' ||
+  fail "support JSON: $(cat "$work/support.json")"
+"$eval" --whole-lines "$work/whole.csv" 2>"$work/support_alone.err" && fail "--whole-lines without --segments must fail"
+grep -q "give --segments too" "$work/support_alone.err" || fail "--whole-lines alone: $(cat "$work/support_alone.err")"
+echo "ok: whole-line support $file_support from the CSVs, $in_process_support in process"
 
 # Every ground-truth step counts: an empty prediction is no score, one step of prediction is
 # charged for all the others, and the GT CSV and the scene give the same steps.
@@ -117,4 +128,4 @@ paste -d' ' "$work/from_file.txt" "$work/from_gt_csv.txt" | awk '{ n = NF / 2; f
     d = $i - $(i + n); if (d < 0) d = -d; if (d > 0.002) exit 1 } }' ||
   fail "GT CSV and scene scores differ: $(cat "$work/from_gt_csv.txt") vs $(cat "$work/from_file.txt")"
 echo "ok: empty prediction -> P n/a, R 0, F 0; one step -> recall $one_step_recall over 41 steps; GT CSV and scene agree"
-echo "offline CLI: 9 passed, 0 failed"
+echo "offline CLI: 10 passed, 0 failed"

@@ -15,6 +15,7 @@
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/eval/plots.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
+#include "evldt/eval/whole_line_support.hpp"
 #include "evldt/sim/scenes.hpp"
 
 namespace evldt {
@@ -544,6 +545,34 @@ TEST(NoiseFilters, KeepTheAccuracyOfACleanSceneAndRecoverMostOfANoisyOnes) {
   const double noisy_filtered = scene_f_at_1_percent("noisy-boxes", 1'000'000, true);
   EXPECT_LT(noisy, clean - 0.1);
   EXPECT_GT(noisy_filtered, noisy + 0.1);
+}
+
+TEST(WholeLineSupport, CountsTheLengthNearASegmentAndTheWeakLines) {
+  WholeLineSupport support;  // 2 px, weak below 60%
+  const Segment left{{0, 0}, {40, 0}}, right{{60, 1}, {100, 1}};  // two collinear edges, a 20 px gap
+  // A whole line on the left edge alone, and one bridging the gap to the right edge.
+  const std::vector<Segment> whole{{{0, 0}, {40, 0}}, {{0, 0.5f}, {100, 0.5f}}};
+  support.add_step(whole, std::vector<Segment>{left, right});
+  SupportSummary s = support.summary();
+  EXPECT_EQ(s.steps, 1u);
+  EXPECT_EQ(s.lines, 2u);
+  EXPECT_NEAR(s.length_px, 140, 1e-3);
+  // The bridge: 84 of its 100 px lie within 2 px of an edge (80 along them, about 2 px into the gap at each end).
+  EXPECT_NEAR(s.supported_share, (40 + 84) / 140.0, 0.02);
+  EXPECT_EQ(s.weak_lines, 0u);
+
+  // A line that cuts across, far from both edges, is unsupported and weak; the figures accumulate.
+  const std::vector<Segment> diagonal{{{0, 30}, {100, 60}}};
+  support.add_step(diagonal, std::vector<Segment>{left, right});
+  s = support.summary();
+  EXPECT_EQ(s.steps, 2u);
+  EXPECT_EQ(s.weak_lines, 1u);
+  EXPECT_NEAR(s.weak_share, 1.0 / 3.0, 1e-9);
+  EXPECT_LT(s.supported_share, (40 + 84) / 140.0);
+
+  EXPECT_TRUE(std::isnan(WholeLineSupport().summary().supported_share));  // no lines: no share
+  EXPECT_THROW(WholeLineSupport(-1.0f), std::invalid_argument);
+  EXPECT_THROW(WholeLineSupport(2.0f, 1.5f), std::invalid_argument);
 }
 
 }  // namespace

@@ -151,6 +151,21 @@ TEST(Scene, VisibleEdgesAreClippedToTheSensorAndByOccluders) {
   EXPECT_EQ(square_edges, 4);
 }
 
+TEST(Scenes, TagBoardEdgesAreSeparateGroundTruthLinesSeenWhole) {
+  const Scene scene = make_scene("tag-board");
+  // The board, 12 markers and 46 white rectangles of their patterns: 59 shapes of 4 edges each. No
+  // shape covers part of another's edge (the patterns' rectangles are a cell apart), so each edge is
+  // one piece, and neighbouring markers' collinear edges stay separate lines across the gaps.
+  ASSERT_EQ(scene.shapes.size(), 59u);
+  for (const Timestamp t : {Timestamp{0}, Timestamp{5'000'000}}) {
+    const std::vector<GtSegment> edges = scene.visible_edges(t);
+    std::map<int, int> pieces;
+    for (const GtSegment& edge : edges) ++pieces[edge.gt_id];
+    EXPECT_EQ(pieces.size(), 236u) << t;
+    for (const auto& [id, count] : pieces) EXPECT_EQ(count, 1) << "gt id " << id << " at " << t;
+  }
+}
+
 TEST(Scenes, EveryBuiltInSceneIsValid) {
   for (const auto& name : scene_names()) {
     const Scene s = make_scene(name);
@@ -267,7 +282,7 @@ namespace evldt {
 namespace {
 
 TEST(Scenes, AGroundTruthIdFollowsOneEdgeThroughOcclusionAndClippingForTenSeconds) {
-  for (const char* name : {"boxes-10s", "poster-10s"}) {
+  for (const char* name : {"boxes-10s", "poster-10s", "tag-board"}) {
     const Scene scene = make_scene(name);
     ASSERT_GE(scene.duration_us, 10'000'000) << name;
     std::map<int, std::pair<Vec2d, Vec2d>> previous;  // gt_id -> a piece at the previous step

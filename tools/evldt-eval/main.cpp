@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <cstdio>
 #include <fstream>
 #include <spdlog/spdlog.h>
@@ -15,6 +16,7 @@
 #include "evldt/eval/json.hpp"
 #include "evldt/eval/plots.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
+#include "evldt/eval/whole_line_support.hpp"
 #include "evldt/lines/segment_csv.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
 #include "evldt/transport/lcm_log.hpp"
@@ -24,7 +26,7 @@ namespace {
 using namespace evldt;
 
 struct Options {
-  std::filesystem::path segments, ground_truth, json, pr_png, lifetime_png, tracks_png;
+  std::filesystem::path segments, whole_lines, ground_truth, json, pr_png, lifetime_png, tracks_png;
   std::string lcm_channel;
   std::vector<double> tolerances{0.01, 0.02};
   std::vector<float> pr_thresholds;
@@ -44,6 +46,7 @@ struct Report {
   Timestamp hold_us = 0;
   LifetimeSummary lifetime;
   TrackingSummary tracking;
+  std::optional<SupportSummary> support;  ///< whole lines: their support by the segments of their step
   std::uint64_t events = 0;
   double scene_seconds = 0, wall_seconds = 0;
 };
@@ -128,6 +131,44 @@ void print_table(const std::vector<Report>& reports, const Options& options) {
   }
 }
 
+void print_support(const std::string& label, const SupportSummary& s) {
+  std::printf("whole-line support of %s: %s of %.0f px within 2 px of a segment of the same step; %llu of %llu lines "
+              "(%s) under 60%% supported\n",
+              label.c_str(), figure(s.supported_share).c_str(), s.length_px, static_cast<unsigned long long>(s.weak_lines),
+              static_cast<unsigned long long>(s.lines), figure(s.weak_share).c_str());
+}
+
+void write_support_json(JsonWriter& json, const SupportSummary& s) {
+  json.key("whole_line_support").begin_object().key("steps").value(s.steps).key("lines").value(s.lines);
+  json.key("length_px").value(s.length_px).key("supported_share").value(s.supported_share);
+  json.key("weak_lines").value(s.weak_lines).key("weak_share").value(s.weak_share).end_object();
+}
+
+// Steps of a segment file: its rows grouped by time (rows of one time are consecutive or not).
+std::map<Timestamp, std::vector<Segment>> steps_of(const std::vector<SegmentRow>& rows) {
+  std::map<Timestamp, std::vector<Segment>> steps;
+  for (const SegmentRow& row : rows) steps[row.t_us].push_back(row.segment);
+  return steps;
+}
+
+// The support of a whole-line file by a segment file of the same run (evldt-offline -o and
+// --whole-lines): every step of the whole lines against the segments of the same time.
+SupportSummary file_support(const Options& options) {
+  const auto whole = steps_of(read_segment_csv(options.whole_lines));
+  const auto segments = steps_of(is_lcm_log(options.segments) ? read_segment_log(options.segments, options.lcm_channel)
+                                                              : read_segment_csv(options.segments));
+  WholeLineSupport support;
+  std::uint64_t unmatched = 0;
+  static const std::vector<Segment> kNone;
+  for (const auto& [t, lines] : whole) {
+    const auto found = segments.find(t);
+    if (found == segments.end()) ++unmatched;
+    support.add_step(lines, found == segments.end() ? kNone : found->second);
+  }
+  if (unmatched > 0) spdlog::warn("{} whole-line steps have no segment step of the same time: scored unsupported", unmatched);
+  return support.summary();
+}
+
 void write_json(const std::vector<Report>& reports, const Options& options) {
   std::ofstream out(options.json);
   if (!out) throw std::runtime_error("cannot create " + options.json.string());
@@ -164,6 +205,7 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
     json.key("ids_per_line").value(t.ids_per_line).key("id_switches").value(t.id_switches);
     json.key("id_precision").value(t.id_precision).key("id_recall").value(t.id_recall).key("idf1").value(t.idf1);
     json.end_object();
+    if (r.support) write_support_json(json, *r.support);
     json.end_object();
   }
   json.end_array().end_object();
@@ -198,6 +240,25 @@ void write_run_plots(const Options& options, const StreamEvaluator& evaluator, c
 int run(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim) {
   std::vector<Report> reports;
   std::optional<StreamEvaluator> last;
+  if (!options.whole_lines.empty() && options.segments.empty()) {
+    spdlog::error("--whole-lines is scored against the segments of the same run: give --segments too");
+    return 1;
+  }
+  if (!options.whole_lines.empty() && options.ground_truth.empty() && !sim.scene_selected()) {
+    // No ground truth: the support alone (a real recording).
+    const SupportSummary support = file_support(options);
+    print_support(options.whole_lines.filename().string(), support);
+    if (!options.json.empty()) {
+      std::ofstream out(options.json);
+      JsonWriter json(out);
+      json.begin_object();
+      write_support_json(json, support);
+      json.end_object();
+      out << "\n";
+      if (!json.done() || !out) throw std::runtime_error("error writing " + options.json.string());
+    }
+    return 0;
+  }
   if (!options.segments.empty()) {
     if (options.ground_truth.empty() == !sim.scene_selected()) {
       spdlog::error("with --segments give the ground truth: --ground-truth FILE or --scene NAME");
@@ -211,6 +272,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     last.emplace(evaluate_files(options, *sensor, sim));
     reports.push_back(make_report(*last));
     reports.back().label = options.segments.filename().string();
+    if (!options.whole_lines.empty()) reports.back().support = file_support(options);
     write_run_plots(options, *last, reports.back(), false);
     const StepCoverage& c = last->coverage();
     spdlog::info("{} ground-truth steps scored, {} of them with no prediction within {:.1f} ms; {} predicted steps, {} "
@@ -244,12 +306,16 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
         r.events = result.events;
         r.scene_seconds = result.scene_seconds;
         r.wall_seconds = wall;
+        if (r.whole_lines) r.support = result.whole_line_support;
         write_run_plots(options, *evaluator, r, thresholds.size() > 1);
         reports.push_back(r);
       }
     }
   }
   print_table(reports, options);
+  for (const Report& r : reports) {
+    if (r.support) print_support(r.label, *r.support);
+  }
   if (!options.json.empty()) write_json(reports, options);
   if (!options.pr_png.empty()) {
     std::vector<PrPoint> points;
@@ -266,7 +332,8 @@ int main(int argc, char** argv) {
   CLI::App app{"evldt-eval: line heat-map precision/recall/F (pixels matched one-to-one within a tolerance of the\n"
                "image diagonal, counts summed over steps) and segment lifetimes. Either score a segment CSV\n"
                "against --ground-truth CSV or a --scene, or run the pipeline on --scene (with --pr-thresholds, once per f_th);\n"
-               "a pipeline run is scored twice: its block segments, and its whole lines (row \"SCENE whole\").\n"
+               "a pipeline run is scored twice: its block segments, and its whole lines (row \"SCENE whole\"), whose\n"
+               "support by the segments is measured too (as --whole-lines does for files, without ground truth).\n"
                "Every ground-truth step is scored, against the latest predicted step at or before it within 1.5 output\n"
                "periods, else against nothing (its ground truth counts as missed). Undefined figures print n/a.\n"
                "Tracking, at the first tolerance: a predicted segment matches the true line within the tolerance of at\n"
@@ -276,6 +343,10 @@ int main(int argc, char** argv) {
   PipelineOptions pipeline_options;
   SimulatorOptions sim_options;
   app.add_option("--segments", options.segments, "Predicted segments: CSV (from evldt-offline) or an lcm-log with segment lists")
+      ->check(CLI::ExistingFile);
+  app.add_option("--whole-lines", options.whole_lines,
+                 "Whole lines (evldt-offline --whole-lines) of the run --segments comes from: their support by its "
+                 "segments (share of their length within 2 px of a segment of the same step); no ground truth needed")
       ->check(CLI::ExistingFile);
   app.add_option("--lcm-channel", options.lcm_channel, "Segment channel of an lcm-log (default: the first LINES_*)");
   app.add_option("--ground-truth", options.ground_truth, "Ground-truth CSV (from evldt-sim)")->check(CLI::ExistingFile);

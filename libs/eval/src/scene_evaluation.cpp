@@ -158,7 +158,8 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
   WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
   std::vector<TrackedLine> joined;
   std::vector<std::uint64_t> ids;
-  std::vector<Segment> predicted;
+  std::vector<Segment> predicted, whole_segments;
+  WholeLineSupport support;
   const auto add = [&](StreamEvaluator& to, Timestamp t, std::span<const TrackedLine> lines) {
     ids.clear();
     predicted.clear();
@@ -174,6 +175,11 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
     joiner.update(t, lines.lines());
     as_tracked_lines(joiner.lines(), joined);
     add(*whole_lines, t, joined);
+    whole_segments.clear();
+    for (const TrackedLine& line : joined) whole_segments.push_back(line.segment);
+    predicted.clear();
+    for (const TrackedLine& line : lines.lines()) predicted.push_back(line.segment);
+    support.add_step(whole_segments, predicted);
   });
   SceneRunResult result;
   EventBatch batch;
@@ -189,6 +195,7 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
   if (whole_lines != nullptr) whole_lines->finish();
   result.scene_seconds = static_cast<double>(scene.duration_us) * 1e-6;
   result.counters = pipeline.counters();
+  result.whole_line_support = support.summary();
   return result;
 }
 

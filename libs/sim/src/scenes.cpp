@@ -189,11 +189,61 @@ Scene poster_10s() {
   return s;
 }
 
+// A printed board of square fiducial markers (as ArUco / AprilTag boards) at DAVIS346's size: 4 x 3
+// black markers, each with an inner pattern of white rectangles on a 5 x 5 grid of cells, on a white
+// board under 10 s of 6-DoF camera motion. Neighbouring markers' outer edges are collinear across the
+// white gaps between them, and the patterns' edges end close to one another: each is its own
+// ground-truth line, so a whole line that bridges a gap or cuts a corner is counted as invented.
+Scene tag_board() {
+  Scene s{"tag-board", {346, 260}, 0.3, {}, {}, 10'000'000};
+  constexpr double kCell = 8, kMarker = 7 * kCell, kGap = 18, kLeft = 34, kTop = 28;
+  s.shapes.push_back(solid(rectangle(kLeft - 14, kTop - 14, kLeft + 4 * kMarker + 3 * kGap + 14, kTop + 3 * kMarker + 2 * kGap + 14), 0.9));
+  // White rectangles (first column, first row, end column, end row) on the inner 5 x 5 cells; two
+  // of one marker are at least a cell apart, so every edge is seen whole.
+  struct Cells {
+    int c0, r0, c1, r1;
+  };
+  static const std::vector<Cells> patterns[12] = {
+      {{0, 0, 2, 1}, {3, 0, 5, 2}, {0, 2, 1, 5}, {2, 3, 4, 4}},
+      {{0, 0, 1, 3}, {2, 0, 5, 1}, {2, 2, 3, 5}, {4, 2, 5, 4}},
+      {{1, 0, 4, 2}, {0, 3, 2, 5}, {3, 3, 5, 4}},
+      {{0, 0, 5, 1}, {0, 2, 2, 3}, {3, 2, 5, 5}, {0, 4, 2, 5}},
+      {{0, 0, 2, 2}, {3, 1, 5, 3}, {1, 3, 2, 5}, {3, 4, 5, 5}},
+      {{2, 0, 3, 5}, {0, 1, 1, 4}, {4, 0, 5, 2}, {4, 3, 5, 5}},
+      {{0, 0, 3, 1}, {4, 0, 5, 3}, {0, 2, 2, 4}, {3, 4, 5, 5}},
+      {{1, 1, 4, 2}, {0, 3, 1, 5}, {2, 3, 5, 5}},
+      {{0, 0, 1, 1}, {2, 0, 3, 2}, {4, 0, 5, 5}, {0, 2, 1, 5}, {2, 3, 3, 5}},
+      {{0, 1, 5, 2}, {0, 3, 2, 5}, {3, 3, 4, 4}},
+      {{0, 0, 2, 3}, {3, 0, 4, 1}, {3, 2, 5, 3}, {0, 4, 5, 5}},
+      {{1, 0, 2, 2}, {3, 0, 5, 1}, {3, 2, 4, 4}, {0, 3, 2, 5}},
+  };
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 4; ++col) {
+      const double x = kLeft + col * (kMarker + kGap), y = kTop + row * (kMarker + kGap);
+      s.shapes.push_back(solid(rectangle(x, y, x + kMarker, y + kMarker), 0.08));
+      for (const Cells& c : patterns[row * 4 + col]) {
+        s.shapes.push_back(solid(rectangle(x + (1 + c.c0) * kCell, y + (1 + c.r0) * kCell, x + (1 + c.c1) * kCell,
+                                           y + (1 + c.r1) * kCell),
+                                 0.9));
+      }
+    }
+  }
+  s.camera.pivot = {173, 130};
+  s.camera.tx = {0, 0, 20, 0.19, 0.8};
+  s.camera.ty = {0, 0, 12, 0.26, 2.2};
+  s.camera.angle = sine(0.16, 0.14, 0.4);
+  s.camera.log_scale = sine(0.09, 0.11, 1.6);
+  s.camera.perspective_x = sine(4e-4, 0.09, 2.7);
+  s.camera.perspective_y = sine(3e-4, 0.12, 0.5);
+  return s;
+}
+
 }  // namespace
 
 const std::vector<std::string>& scene_names() {
   static const std::vector<std::string> names{"three-lines-fast", "circle-board", "boxes-6dof", "multi-speed", "monitor-hd",
-                                              "noisy-boxes", "flicker-lamps", "night-boxes", "boxes-10s", "poster-10s"};
+                                              "noisy-boxes", "flicker-lamps", "night-boxes", "boxes-10s", "poster-10s",
+                                              "tag-board"};
   return names;
 }
 
@@ -227,6 +277,7 @@ Scene make_scene(std::string_view name) {
   if (name == "night-boxes") return night_boxes();
   if (name == "boxes-10s") return boxes_10s();
   if (name == "poster-10s") return poster_10s();
+  if (name == "tag-board") return tag_board();
   std::string valid;
   for (const auto& n : scene_names()) valid += (valid.empty() ? "" : ", ") + n;
   throw std::invalid_argument("unknown scene '" + std::string(name) + "' (built-in scenes: " + valid + ")");

@@ -10,6 +10,7 @@
 #include "evldt/eval/accumulator.hpp"
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/eval/tracking_metrics.hpp"
+#include "evldt/eval/whole_line_support.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/lines/segment_csv.hpp"
 #include "evldt/sim/event_simulator.hpp"
@@ -105,12 +106,14 @@ struct SceneRunResult {
   std::uint64_t events = 0;
   double scene_seconds = 0;
   PipelineCounters counters;
+  SupportSummary whole_line_support;  ///< of the whole lines by the segments of their step, when scored
 };
 
 /// Simulates the scene, runs the deterministic pipeline on it with an output every step_us and scores
 /// it on the scene's ground-truth steps (scene_ground_truth_steps) with a hold of
 /// kHoldPeriods * step_us. `evaluator` must have been made for those steps; so must `whole_lines`,
-/// which, when given, scores the whole lines (WholeLineTracker, config.whole_lines) of each output.
+/// which, when given, scores the whole lines (WholeLineTracker, config.whole_lines) of each output
+/// and measures their support by the segments (WholeLineSupport's defaults).
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
                               Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines = nullptr);
 
