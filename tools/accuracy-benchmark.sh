@@ -2,7 +2,8 @@
 # Accuracy benchmark: every built-in scene through the deterministic pipeline and the evaluator with
 # the default parameters, then again without the noise filters ("/none" rows); one table (line
 # heat-map P/R/F at 1% and 2% of the diagonal, segments per step, ids, lifetimes, tracking metrics,
-# event rate), a row for the block segments and one for the whole lines of each run.
+# event rate), a row for the block segments and one for the whole lines of each run, and the whole
+# lines' support by the segments.
 # Usage: tools/accuracy-benchmark.sh [BUILD_DIR] [OUT_DIR]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -26,6 +27,7 @@ for filters in default none; do
     # A row for the segments and one for the whole lines of the same run.
     while IFS= read -r line; do
       [[ $filters == none ]] && line="${line/$scene/$scene/none}"
+      [[ $line == "whole-line support"* ]] && { echo "$line"; continue; }
       echo "$line   ${rate} Mev/s"
     done < <(tail -n +2 "$out/$name.txt")
   done
