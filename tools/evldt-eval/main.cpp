@@ -88,10 +88,9 @@ std::optional<std::pair<Timestamp, Timestamp>> recorded_event_span(const std::fi
 
 // The rule is StreamEvaluator's: every ground-truth step, against the latest predicted step at or
 // before it within 1.5 output periods.
-StreamEvaluator evaluate_files(const Options& options, SensorSize sensor, const SimulatorOptions& sim) {
+StreamEvaluator evaluate_files(const Options& options, std::vector<SegmentRow> rows, SensorSize sensor,
+                               const SimulatorOptions& sim) {
   const bool from_log = is_lcm_log(options.segments);
-  std::vector<SegmentRow> rows =
-      from_log ? read_segment_log(options.segments, options.lcm_channel) : read_segment_csv(options.segments);
   GroundTruthSteps truth = sim.scene_selected() ? scene_ground_truth_steps(sim.scene(), options.step_us)
                                                 : csv_ground_truth_steps(read_ground_truth_csv(options.ground_truth));
   if (from_log) {
@@ -144,19 +143,24 @@ void write_support_json(JsonWriter& json, const SupportSummary& s) {
   json.key("weak_lines").value(s.weak_lines).key("weak_share").value(s.weak_share).end_object();
 }
 
-// Steps of a segment file: its rows grouped by time (rows of one time are consecutive or not).
+// Steps of a segment file: its rows grouped by time, in whatever order the rows come.
 std::map<Timestamp, std::vector<Segment>> steps_of(const std::vector<SegmentRow>& rows) {
   std::map<Timestamp, std::vector<Segment>> steps;
   for (const SegmentRow& row : rows) steps[row.t_us].push_back(row.segment);
   return steps;
 }
 
-// The support of a whole-line file by a segment file of the same run (evldt-offline -o and
+// The predicted segments of --segments: a CSV, or the segment lists of an lcm-log.
+std::vector<SegmentRow> read_segments(const Options& options) {
+  return is_lcm_log(options.segments) ? read_segment_log(options.segments, options.lcm_channel)
+                                      : read_segment_csv(options.segments);
+}
+
+// The support of a whole-line file by the segments of the same run (evldt-offline -o and
 // --whole-lines): every step of the whole lines against the segments of the same time.
-SupportSummary file_support(const Options& options) {
-  const auto whole = steps_of(read_segment_csv(options.whole_lines));
-  const auto segments = steps_of(is_lcm_log(options.segments) ? read_segment_log(options.segments, options.lcm_channel)
-                                                              : read_segment_csv(options.segments));
+SupportSummary file_support(const std::vector<SegmentRow>& segment_rows, const std::filesystem::path& whole_lines) {
+  const auto whole = steps_of(read_segment_csv(whole_lines));
+  const auto segments = steps_of(segment_rows);
   WholeLineSupport support;
   std::uint64_t unmatched = 0;
   static const std::vector<Segment> kNone;
@@ -246,7 +250,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   }
   if (!options.whole_lines.empty() && options.ground_truth.empty() && !sim.scene_selected()) {
     // No ground truth: the support alone (a real recording).
-    const SupportSummary support = file_support(options);
+    const SupportSummary support = file_support(read_segments(options), options.whole_lines);
     print_support(options.whole_lines.filename().string(), support);
     if (!options.json.empty()) {
       std::ofstream out(options.json);
@@ -269,10 +273,13 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       spdlog::error("give the sensor size (--width/--height or --config) for file-only evaluation");
       return 1;
     }
-    last.emplace(evaluate_files(options, *sensor, sim));
+    std::vector<SegmentRow> rows = read_segments(options);
+    std::optional<SupportSummary> support;
+    if (!options.whole_lines.empty()) support = file_support(rows, options.whole_lines);
+    last.emplace(evaluate_files(options, std::move(rows), *sensor, sim));
     reports.push_back(make_report(*last));
     reports.back().label = options.segments.filename().string();
-    if (!options.whole_lines.empty()) reports.back().support = file_support(options);
+    reports.back().support = support;
     write_run_plots(options, *last, reports.back(), false);
     const StepCoverage& c = last->coverage();
     spdlog::info("{} ground-truth steps scored, {} of them with no prediction within {:.1f} ms; {} predicted steps, {} "

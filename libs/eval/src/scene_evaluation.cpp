@@ -158,7 +158,7 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
   WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
   std::vector<TrackedLine> joined;
   std::vector<std::uint64_t> ids;
-  std::vector<Segment> predicted, whole_segments;
+  std::vector<Segment> predicted, step_segments;
   WholeLineSupport support;
   const auto add = [&](StreamEvaluator& to, Timestamp t, std::span<const TrackedLine> lines) {
     ids.clear();
@@ -174,12 +174,9 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
     if (whole_lines == nullptr) return;
     joiner.update(t, lines.lines());
     as_tracked_lines(joiner.lines(), joined);
+    predicted.swap(step_segments);  // the segments' geometry, which add() made, for the support
     add(*whole_lines, t, joined);
-    whole_segments.clear();
-    for (const TrackedLine& line : joined) whole_segments.push_back(line.segment);
-    predicted.clear();
-    for (const TrackedLine& line : lines.lines()) predicted.push_back(line.segment);
-    support.add_step(whole_segments, predicted);
+    support.add_step(predicted, step_segments);
   });
   SceneRunResult result;
   EventBatch batch;
