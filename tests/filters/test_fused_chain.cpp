@@ -103,10 +103,10 @@ struct Setting {
   Timestamp refractory_us;
 };
 
-// The default chain and two others of all four filters; with background-activity always dropping
-// and a long refractory period too, so that every filter drops on every stream.
+// The default chain and two other orders of the four filters; with background-activity always
+// dropping and a long refractory period too, so that every filter drops on every stream.
 constexpr Setting kSettings[] = {
-    {"default", "hot-pixel,anti-flicker,background-activity", 1.0, 100},
+    {"default", "refractory,hot-pixel,anti-flicker,background-activity", 1.0, 300},
     {"all four", "refractory,background-activity,hot-pixel,anti-flicker", 1.0, 100},
     {"all four, eager", "anti-flicker,refractory,hot-pixel,background-activity", 0.0, 2000},
 };

@@ -83,13 +83,13 @@ void PipelineOptions::add_to(CLI::App& app) {
   auto* filters = app.add_option_group("Noise filters", "Run before storage, in the order given");
   filters->add_option("--filters", filters_,
                       "Filters in order, comma-separated: hot-pixel, background-activity, refractory, anti-flicker; or none\n"
-                      "(default: hot-pixel,anti-flicker,background-activity)");
+                      "(default: refractory,hot-pixel,anti-flicker,background-activity)");
   filters->add_option("--filter-ba-window-us", ba_window_, "background-activity: a neighbour must have fired within this")
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
   filters->add_option("--filter-ba-min-noise-hz", ba_min_noise_hz_,
                       "background-activity: drop only while uncorrelated events come at this rate per pixel or more (0: always)")
       ->check(finite_number() & CLI::Range(0.0, 1000.0));
-  filters->add_option("--filter-refractory-us", filter_refractory_, "refractory: a pixel's events closer than this are dropped")
+  filters->add_option("--filter-refractory-us", filter_refractory_, "refractory: a pixel's events closer than this to its previous passed one are dropped (default 300)")
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));
   filters->add_option("--filter-hot-window-us", hot_window_, "hot-pixel: rates are judged over windows of this event time")
       ->check(CLI::Range(Timestamp{1000}, Timestamp{60'000'000}));
