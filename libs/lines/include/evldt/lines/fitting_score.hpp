@@ -37,7 +37,7 @@ class FittingScorer {
 
  private:
   float inlier_distance_;
-  std::vector<std::uint64_t> bins_;  // scratch bitset of occupied 1-px bins (+ a spare word), reused across calls
+  std::vector<std::uint8_t> bins_;          // scratch: 1 where a 1-px bin holds an inlier (+ a spare bin), reused across calls
   std::vector<std::int32_t> point_bins_;    // scratch: each point's bin
   std::vector<float> point_distances_;      // scratch: each point's distance if an inlier, else 0
 };
