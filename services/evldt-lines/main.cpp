@@ -42,6 +42,11 @@ int main(int argc, char** argv) {
                  "Whole-line lists per second at most (each goes with a segment list)")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.1, 10000.0));
+  app.add_option("--whole-lines-loaded-hz", options.whole_lines_loaded_hz,
+                 "Whole-line lists per second at most while batches are being shed (until none has been for 1 s): "
+                 "the tracking rounds get the CPU first")
+      ->capture_default_str()
+      ->check(finite_number() & CLI::Range(0.1, 10000.0));
   app.add_option("--log-period-s", options.log_period_s, "A status line in the log this often (0: never)")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.0, 3600.0));
@@ -71,7 +76,7 @@ int main(int argc, char** argv) {
         "  events    %llu received, %llu stored, %llu dropped as invalid (%llu off sensor, %llu back in time), %llu clock resets\n"
         "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
         "  loops     %llu detection rounds, %llu tracking rounds\n"
-        "  output    %llu lines created, %llu segment lists published\n"
+        "  output    %llu lines created, %llu segment lists published, %llu whole-line lists (%llu at %.0f Hz while shedding)\n"
         "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches); settled, from 1 s after\n"
         "            the first batch: median %.1f ms, p99 %.1f ms (%u batches)\n",
         static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),
@@ -87,7 +92,8 @@ int main(int argc, char** argv) {
         static_cast<unsigned long long>(t.filtered.background_activity), static_cast<unsigned long long>(t.filtered.refractory),
         static_cast<unsigned long long>(t.filtered.anti_flicker), static_cast<unsigned long long>(t.detect_rounds),
         static_cast<unsigned long long>(t.track_rounds), static_cast<unsigned long long>(t.lines_created),
-        static_cast<unsigned long long>(t.lists_published), t.latency.median_ms, t.latency.p99_ms, t.latency.samples,
+        static_cast<unsigned long long>(t.lists_published), static_cast<unsigned long long>(t.whole_lists_published),
+        static_cast<unsigned long long>(t.whole_lists_while_shedding), options.whole_lines_loaded_hz, t.latency.median_ms, t.latency.p99_ms, t.latency.samples,
         t.settled_latency.median_ms, t.settled_latency.p99_ms, t.settled_latency.samples);
     return 0;
   });

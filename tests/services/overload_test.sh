@@ -5,7 +5,7 @@
 #     it, costs no CPU.
 #  2. A consumer slowed on purpose (evldt-lines stopped with SIGSTOP for 300 ms, twice) sheds the
 #     batches that queued past its latency budget, counts them apart from losses (summary and
-#     statistics messages), loses none, and keeps the median latency of what it stored within the budget.
+#     statistics messages), slows its whole lines meanwhile, loses none, and keeps the median latency of what it stored within the budget.
 # Usage: overload_test.sh BUILD_DIR SOURCE_DIR
 set -uo pipefail
 build=$1
@@ -64,6 +64,7 @@ wait "$lines_pid"
 cat "$work/idle.out"
 check "an unhurried run sheds nothing (budget $idle_budget_ms ms)" grep -qP "shed +0 batches, 0 events" "$work/idle.out"
 check "... and loses nothing" grep -qP "batches +$batches received, 0 lost" "$work/idle.out"
+check "... and keeps whole lines at their full rate" grep -qP "whole-line lists \(0 at [0-9]+ Hz while shedding\)" "$work/idle.out"
 
 # --- 2. slowed on purpose -----------------------------------------------------------------------
 "$probe" "$url" cam0 60 >"$work/probe.out" &
@@ -89,6 +90,8 @@ shed=$(field "$work/slow.out" 'shed')
 p99=$(grep -oP 'p99 \K[0-9.]+' "$work/slow.out" | head -1)
 check "the stalled evldt-lines shed batches that queued past ${budget_ms} ms ($shed)" test "${shed:-0}" -gt 0
 check "... counted apart from losses: none lost" grep -qP "batches +$batches received, 0 lost" "$work/slow.out"
+loaded=$(grep -oP 'whole-line lists \(\K[0-9]+(?= at [0-9]+ Hz while shedding)' "$work/slow.out" || true)
+check "... and slowed its whole lines while it shed, so the rounds get the CPU first ($loaded lists)" test "${loaded:-0}" -gt 0
 check "... in its statistics messages too" \
   awk -v n="$shed" '$1 == "stats" && $3 == "evldt-lines" { v = $9 } END { exit !(v > 0 && v <= n) }' "$work/probe.out"
 # Shed, what is stored waits at most the budget plus a round and a list; the few batches stored just

@@ -17,6 +17,9 @@ constexpr std::size_t kMaxListedMaskedPixels = 4096;
 
 using Clock = std::chrono::steady_clock;
 
+// Whole lines stay at their lower rate until no batch has been shed for this long.
+constexpr std::chrono::seconds kSheddingMemory{1};
+
 Clock::duration period_of(double hz) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / hz));
 }
@@ -38,7 +41,8 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
       next_whole_id_(static_cast<std::uint64_t>(epoch_us)) {
   batch_.reserve_touched(1 << 16);
   if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100) ||
-      !(options_.whole_lines_hz > 0 && options_.whole_lines_hz <= 10000)) {
+      !(options_.whole_lines_hz > 0 && options_.whole_lines_hz <= 10000) ||
+      !(options_.whole_lines_loaded_hz > 0 && options_.whole_lines_loaded_hz <= 10000)) {
     throw std::invalid_argument("publish and whole-line rates must be in (0, 10000] Hz and the stats rate in (0, 100] Hz");
   }
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
@@ -217,15 +221,33 @@ bool LinesNode::publish_segments(bool heartbeat) {
   // Whole lines at most at their rate in wall time (up to a publish period early, so at equal
   // rates they go with every segment list) and in event time (up to a tracking period early): a
   // stream replayed slowly costs whole-line steps in proportion to its event time, as it does rounds.
+  // While batches are being shed, at their lower rate: the service is past its means, and the
+  // tracking rounds, whose lists the whole lines are built from, need the CPU first.
   const auto now_steady = Clock::now();
-  const Timestamp event_period_us =
-      static_cast<Timestamp>(1e6 / options_.whole_lines_hz) - engine->config().schedule.track_period_us;
+  std::uint64_t shed;
+  {
+    std::lock_guard lock(mutex_);
+    shed = receiver_counts_.batches_shed;
+  }
+  if (shed != shed_seen_) {
+    if (shed_seen_ == 0 || now_steady - last_shed_ >= kSheddingMemory) {
+      spdlog::info("shedding: whole lines at most {} Hz until no batch has been shed for {} s", options_.whole_lines_loaded_hz,
+                   std::chrono::duration<double>(kSheddingMemory).count());
+    }
+    shed_seen_ = shed;
+    last_shed_ = now_steady;
+  }
+  const bool shedding = shed_seen_ > 0 && now_steady - last_shed_ < kSheddingMemory;
+  const double whole_hz = shedding ? std::min(options_.whole_lines_hz, options_.whole_lines_loaded_hz) : options_.whole_lines_hz;
+  const Timestamp event_period_us = static_cast<Timestamp>(1e6 / whole_hz) - engine->config().schedule.track_period_us;
   const bool whole_due = now_steady >= next_whole_list_ &&
                          (!joiner_ || engine != joined_engine_ || lattice_us < joiner_->last_time() ||
                           lattice_us - joiner_->last_time() >= event_period_us);
   if (options_.whole_lines && whole_due) {
-    next_whole_list_ = now_steady + period_of(options_.whole_lines_hz) - period_of(options_.publish_hz);
+    next_whole_list_ = now_steady + period_of(whole_hz) - period_of(options_.publish_hz);
     publish_whole_lines(engine, lattice_us);
+    whole_lists_published_.fetch_add(1, std::memory_order_relaxed);
+    if (shedding) whole_lists_while_shedding_.fetch_add(1, std::memory_order_relaxed);
   }
   return true;
 }
@@ -328,6 +350,8 @@ LinesNodeTotals LinesNode::totals() const {
     totals.lines_created += counters.lines_created;
   }
   totals.lists_published = lists_published_.load(std::memory_order_relaxed);
+  totals.whole_lists_published = whole_lists_published_.load(std::memory_order_relaxed);
+  totals.whole_lists_while_shedding = whole_lists_while_shedding_.load(std::memory_order_relaxed);
   return totals;
 }
 

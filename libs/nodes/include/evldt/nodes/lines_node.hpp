@@ -41,6 +41,9 @@ struct LinesNodeOptions {
   /// Whole-line lists per second at most: with a segment list, once 1 / whole_lines_hz has passed since
   /// the last (a whole-line step costs 1.8 ms at HD; lines change little in 1 ms).
   double whole_lines_hz = 100;
+  /// While the service sheds (a batch shed within the last second), whole lines go out at most this
+  /// often: at HD they took a quarter of a core at 100 Hz, which the tracking rounds need more.
+  double whole_lines_loaded_hz = 10;
 };
 
 /// Totals since start (what the stats message and the exit summary report).
@@ -53,6 +56,8 @@ struct LinesNodeTotals {
   std::uint64_t track_rounds = 0;
   std::uint64_t lines_created = 0;
   std::uint64_t lists_published = 0;
+  std::uint64_t whole_lists_published = 0;
+  std::uint64_t whole_lists_while_shedding = 0;  ///< of them, published at whole_lines_loaded_hz
   std::uint64_t engine_restarts = 0;  ///< the camera restarted (new epoch): the lattice began afresh
   LatencySummary latency;             ///< batch publish -> first list including it, since the last camera (re)start
   LatencySummary settled_latency;     ///< the same, of the batches published 1 s or more after the first (LatencyTracker)
@@ -120,6 +125,9 @@ class LinesNode {
   segment_list_t whole_msg_;
   std::int64_t whole_seq_ = 0;
   std::chrono::steady_clock::time_point next_whole_list_{};
+  std::uint64_t shed_seen_ = 0;                          ///< batches shed when the publisher last looked
+  std::chrono::steady_clock::time_point last_shed_{};    ///< when it last saw that number grow
+  std::atomic<std::uint64_t> whole_lists_published_{0}, whole_lists_while_shedding_{0};
   LinesNodeTotals last_stats_;
   LatencySummary last_latency_;  ///< of the last statistics message, for the log line
 };
