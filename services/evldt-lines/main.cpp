@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
         "  events    %llu received, %llu stored, %llu dropped as invalid (%llu off sensor, %llu back in time), %llu clock resets\n"
         "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
         "  loops     %llu detection rounds, %llu tracking rounds\n"
-        "  output    %llu lines created, %llu segment lists published, %llu whole-line lists (%llu at %.0f Hz while shedding)\n"
+        "  output    %llu lines created, %llu segment lists published, %llu whole-line lists (%llu at %g Hz while shedding)\n"
         "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches); settled, from 1 s after\n"
         "            the first batch: median %.1f ms, p99 %.1f ms (%u batches)\n",
         static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),

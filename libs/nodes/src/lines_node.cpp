@@ -230,7 +230,7 @@ bool LinesNode::publish_segments(bool heartbeat) {
     shed = receiver_counts_.batches_shed;
   }
   if (shed != shed_seen_) {
-    if (shed_seen_ == 0 || now_steady - last_shed_ >= kSheddingMemory) {
+    if (options_.whole_lines && (shed_seen_ == 0 || now_steady - last_shed_ >= kSheddingMemory)) {
       spdlog::info("shedding: whole lines at most {} Hz until no batch has been shed for {} s", options_.whole_lines_loaded_hz,
                    std::chrono::duration<double>(kSheddingMemory).count());
     }
