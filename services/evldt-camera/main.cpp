@@ -3,10 +3,12 @@
 
 #include <CLI/CLI.hpp>
 #include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
 
 #include "evldt/app/lcm_options.hpp"
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/source_options.hpp"
+#include "evldt/lines/thread_name.hpp"
 #include "evldt/nodes/camera_node.hpp"
 #include "evldt/transport/channels.hpp"
 
@@ -48,6 +50,11 @@ int main(int argc, char** argv) {
     options.camera = lcm_options.camera();
     if (quiet) options.progress_period_s = 0;
     const auto& stop = stop_on_signals();
+    // Reading, batching and publishing run above normal work (the subscribers' rounds on this
+    // host): a camera that falls behind catches up in a burst, which overflows socket buffers.
+    if (!raise_this_thread_for_ingest()) {
+      spdlog::info("publishing runs at normal priority: raising it needs CAP_SYS_NICE (README, real time)");
+    }
     const auto lcm = lcm_options.connect();
     CameraNode node(*lcm, options, process_epoch_us());
     announce_ready("evldt-camera", fmt::format("publishing on {} ({})", events_channel(options.camera), lcm_options.effective_url()));

@@ -58,9 +58,9 @@ int main(int argc, char** argv) {
     options.configure = [&](SensorSize sensor) { return pipeline_options.resolve(sensor); };
     if (options.sensor) (void)pipeline_options.resolve(*options.sensor);  // a bad value fails now, not at the first batch
     const auto& stop = stop_on_signals();
-    // This thread receives and stores events, with LCM's reading thread, which it starts: above the
-    // rounds, which must take what the cores have left, not delay storage.
-    if (!raise_this_thread_above_rounds()) {
+    // This thread handles LCM and starts the store thread: both above the rounds, which must take
+    // what the cores have left, not delay storage.
+    if (!raise_this_thread_for_ingest()) {
       spdlog::info("storage runs at the rounds' priority: raising it needs CAP_SYS_NICE (README, real time)");
     }
     const auto lcm = lcm_options.connect();

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Bounded latency with the real processes over UDP multicast on loopback (ttl=0):
-#  1. A run well within the machine's means sheds nothing; its receiving thread runs 10 nice steps
-#     above its rounds (where the test may raise it: as root); waiting, before the stream and after
-#     it, costs no CPU.
+#  1. A run well within the machine's means sheds nothing; its receiving and storing threads run 10
+#     nice steps above its rounds, LCM's socket reader real-time, and the camera 10 steps above
+#     normal (where the test may raise them: as root); waiting, before the stream and after it,
+#     costs no CPU.
 #  2. A consumer slowed on purpose (evldt-lines stopped with SIGSTOP for 300 ms, twice) sheds the
 #     batches that queued past its latency budget, counts them apart from losses (summary and
 #     statistics messages), slows its whole lines meanwhile, loses none, and keeps the median latency of what it stored within the budget.
@@ -44,7 +45,7 @@ camera_pid=$!
 # The engine's threads start with the first batch. Each thread's id, name and nice value from its
 # stat line (one awk for all, so polling disturbs little; names have no spaces here); the
 # receiving thread is the main one.
-thread_nice() { awk '{ gsub(/[()]/, "", $2); print $1, $2, $19 }' /proc/"$lines_pid"/task/*/stat; }
+thread_nice() { awk '{ gsub(/[()]/, "", $2); print $1, $2, $19, $41 }' /proc/"$lines_pid"/task/*/stat; }
 tracking_started() { thread_nice | grep -q ' evldt-track '; }
 wait_until "evldt-lines's tracking thread" tracking_started
 threads=$(thread_nice)
@@ -52,6 +53,14 @@ echo "$threads"
 if [[ $(id -u) == 0 ]]; then
   check "the receiving thread runs 10 nice steps above the tracking loop" \
     awk -v pid="$lines_pid" '$1 == pid { r = $3 } $2 == "evldt-track" { t = $3 } END { exit !(r != "" && t != "" && t - r == 10) }' <<<"$threads"
+  check "the storing thread runs 10 nice steps above the tracking loop" \
+    awk '$2 == "evldt-store" { s = $3 } $2 == "evldt-track" { t = $3 } END { exit !(s != "" && t != "" && t - s == 10) }' <<<"$threads"
+  # Policy 1 is SCHED_FIFO: LCM's thread reading the socket (and, in a ThreadSanitizer build, the
+  # sanitizer's own thread, which starts with it); never storage or the rounds.
+  check "LCM's socket reader runs real-time" \
+    awk '$4 == 1 { n++; if ($2 != "evldt-lines") bad++ } END { exit !(n >= 1 && n <= 2 && bad == 0) }' <<<"$threads"
+  check "the camera runs 10 nice steps above normal" \
+    awk '{ exit !($19 == -10) }' /proc/"$(pgrep -n -f "evldt-camera --lcm-url ${url%%\?*}")"/stat
 else
   echo "skipped the priority check: not root, so evldt-lines may not raise its receiving thread"
 fi

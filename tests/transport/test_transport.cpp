@@ -19,6 +19,7 @@
 #include "evldt/transport/lcm_log.hpp"
 #include "evldt/transport/messages.hpp"
 #include "evldt/transport/pacer.hpp"
+#include "evldt/transport/payload_queue.hpp"
 #include "evldt/transport/sensor_lag.hpp"
 #include "evldt/transport/sequence_tracker.hpp"
 
@@ -878,3 +879,53 @@ TEST_F(LcmLogFiles, MissingOrForeignFilesAreClearErrors) {
 
 }  // namespace
 }  // namespace evldt
+
+namespace {
+std::vector<std::uint8_t> bytes_of(std::size_t size, std::uint8_t fill) { return std::vector<std::uint8_t>(size, fill); }
+}  // namespace
+
+TEST(PayloadQueue, HandsOverPayloadsInOrderAndGrowsASlotForALargeOne) {
+  evldt::PayloadQueue queue(3, 16);
+  const std::atomic<bool> never{false};
+  ASSERT_TRUE(queue.push(bytes_of(5, 1), never));
+  ASSERT_TRUE(queue.push(bytes_of(40, 2), never));  // larger than a slot: that slot grows
+  ASSERT_TRUE(queue.push({}, never));
+  for (const auto& [size, fill] : std::vector<std::pair<std::size_t, std::uint8_t>>{{5, 1}, {40, 2}, {0, 0}}) {
+    const auto payload = queue.front(std::chrono::milliseconds(0));
+    ASSERT_TRUE(payload.has_value());
+    ASSERT_EQ(payload->size(), size);
+    for (const std::uint8_t byte : *payload) EXPECT_EQ(byte, fill);
+    queue.pop();
+  }
+  EXPECT_FALSE(queue.front(std::chrono::milliseconds(1)).has_value());
+  EXPECT_EQ(queue.high_water(), 3u);
+  // The slots go round: a fourth and fifth payload reuse the first two.
+  ASSERT_TRUE(queue.push(bytes_of(7, 4), never));
+  ASSERT_TRUE(queue.push(bytes_of(30, 5), never));
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 7u);
+  queue.pop();
+  EXPECT_EQ((*queue.front(std::chrono::milliseconds(0)))[29], 5);
+}
+
+TEST(PayloadQueue, AFullQueueHoldsTheProducerUntilASlotFreesOrItStops) {
+  evldt::PayloadQueue queue(1, 8);
+  std::atomic<bool> stop{false};
+  ASSERT_TRUE(queue.push(bytes_of(1, 1), stop));
+  std::atomic<bool> second_queued{false};
+  std::thread producer([&] { second_queued = queue.push(bytes_of(2, 2), stop); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(second_queued.load());  // waits: nothing was dropped or overwritten
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 1u);
+  queue.pop();
+  producer.join();
+  EXPECT_TRUE(second_queued.load());
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 2u);
+
+  // Full again, and stopped meanwhile: the producer gives up.
+  std::thread stopped_producer([&] { second_queued = queue.push(bytes_of(3, 3), stop); });
+  stop = true;
+  stopped_producer.join();
+  EXPECT_FALSE(second_queued.load());
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 2u);
+  EXPECT_THROW(evldt::PayloadQueue(0, 8), std::invalid_argument);
+}

@@ -65,9 +65,15 @@ bool EventBatchReceiver::admit() {
     refuse("sensor size this subscriber cannot work with");
     return false;
   }
-  const std::uint64_t restarts_before = sequence_.counts().restarts;
+  const SequenceCounts before = sequence_.counts();
   if (!sequence_.observe(message_.epoch, message_.seq)) return false;
-  restarted_ = sequence_.counts().restarts != restarts_before;
+  restarted_ = sequence_.counts().restarts != before.restarts;
+  if (const std::uint64_t lost = sequence_.counts().lost; lost != before.lost && std::bit_floor(lost) > before.lost) {
+    // Batches the network or this host dropped before they were read (a socket buffer overflowing
+    // while the host was busy, most often): the lattice missed their events.
+    spdlog::warn("lost {} event batch(es) in all (sequence gaps; latest before seq {}): is net.core.rmem_max at least "
+                 "8 MiB (deploy/README.md)?", lost, message_.seq);
+  }
   if (!sensor_) sensor_ = size;
   if (!validator_ || restarted_) {
     // A restarted camera's clock may begin again: judge its time order afresh.

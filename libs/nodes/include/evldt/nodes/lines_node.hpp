@@ -1,7 +1,8 @@
 #pragma once
 // The evldt-lines service without its command line: subscribes to one camera's event batches,
-// stores them in the real-time engine on the receive thread (which never waits for a detection or
-// tracking pass), sheds the batches that come later than its latency budget, and publishes the
+// queues each as it arrives (LCM's handler only copies it), stores them in the real-time engine on
+// a thread of their own (which never waits for a detection or tracking pass), sheds the batches
+// that come later than its latency budget, and publishes the
 // live segments whenever a round changed them (at most at a set rate, at least once a second) and
 // its statistics once a second.
 
@@ -15,11 +16,14 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
+#include <sys/types.h>
 
 #include "evldt/lines/realtime_engine.hpp"
 #include "evldt/lines/whole_lines.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 #include "evldt/transport/latency_tracker.hpp"
+#include "evldt/transport/payload_queue.hpp"
 
 namespace evldt {
 
@@ -72,12 +76,17 @@ class LinesNode {
   LinesNode(const LinesNode&) = delete;
   LinesNode& operator=(const LinesNode&) = delete;
 
-  /// Receives and publishes until `stop` is set (checked every 100 ms), then stops the engine.
+  /// Receives, stores and publishes until `stop` is set (checked every 100 ms), then stops the engine.
   void run(const std::atomic<bool>& stop);
   [[nodiscard]] LinesNodeTotals totals() const;
 
  private:
+  /// Makes real-time the threads started since `threads_before` was taken (LCM's socket reader).
+  static void make_socket_readers_realtime(const std::vector<pid_t>& threads_before);
   void on_events(const lcm::ReceiveBuffer* buffer, const std::string& channel);
+  void store_loop(const std::atomic<bool>& stop);
+  /// Decodes one queued batch and stores it, or sheds it if it queued longer than the budget.
+  void store(std::span<const std::uint8_t> payload);
   void start_engine();
   /// A started engine for `sensor` whose lines are numbered from `first_line_id`.
   [[nodiscard]] std::shared_ptr<RealtimeEngine> make_engine(SensorSize sensor, std::uint64_t first_line_id) const;
@@ -96,13 +105,17 @@ class LinesNode {
   std::string whole_lines_channel_;
   lcm::Subscription* subscription_ = nullptr;
 
-  // Receive thread only.
+  // The thread that handles LCM queues batches here; the store thread takes them.
+  PayloadQueue queue_;
+  const std::atomic<bool>* stop_ = nullptr;  ///< run()'s, which the handler waits on when the queue is full
+
+  // Store thread only.
   EventBatchReceiver receiver_;
   LatencyBudget budget_;
   EventBatch batch_;
   std::shared_ptr<RealtimeEngine> prebuilt_;  ///< built and started at start for a configured sensor, for the first batch
 
-  mutable std::mutex mutex_;  // guards the members below (the receive thread alone writes them)
+  mutable std::mutex mutex_;  // guards the members below (the store thread alone writes them)
   std::uint64_t next_line_id_;
   std::shared_ptr<RealtimeEngine> engine_;
   std::condition_variable engine_started_;  ///< wakes the publisher, which waits for the first engine
