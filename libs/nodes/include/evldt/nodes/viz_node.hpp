@@ -55,7 +55,10 @@ class VizNode {
   bool apply_key(int key) { return toggle_layer(options_.render, key); }
   /// Counts so far (call from the thread that runs the node, e.g. in the frame handler, or after run).
   [[nodiscard]] VizTotals totals() const;
-  static constexpr std::chrono::milliseconds kStopDrain{200};
+  /// Long enough for a viewer that fell behind on a starved host (a ThreadSanitizer build beside two
+  /// busy loops had 0.8 s of a stream queued), short of systemd's stop timeout (3 s); a viewer that
+  /// kept up stops at once.
+  static constexpr std::chrono::milliseconds kStopDrain{2000};
 
  private:
   using Clock = std::chrono::steady_clock;
