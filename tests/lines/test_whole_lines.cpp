@@ -287,6 +287,33 @@ TEST(WholeLineTracker, SegmentsAlongACircleDoNotChainIntoOneLine) {
   for (const WholeLine& l : tracker.lines()) EXPECT_LE(l.segments, 3u);
 }
 
+TEST(WholeLineTracker, ANewSegmentAcrossAGapJoinsOnlyWhereTheLatticeHoldsEventsAlongIt) {
+  // Two edges on y = 20: x 8-40 and x 52-84, a 12 px gap between them (within the 16 px a gap may
+  // span on geometry alone, over the 4 px crossed without evidence).
+  const std::vector<TrackedLine> pieces = pieces_along(20, 8, 40, 1) + pieces_along(20, 52, 84, 11);
+  // Events along both edges, and (in the second lattice) along the gap between them as well.
+  ScarfLattice separate(SensorSize{128, 64}, kBlock, 2.0), one_edge(SensorSize{128, 64}, kBlock, 2.0);
+  for (std::uint16_t x = 8; x <= 84; ++x) {
+    if (x <= 40 || x >= 52) separate.insert(x, 20);
+    one_edge.insert(x, 20);
+  }
+  const auto lines_with = [&](const ScarfLattice* events) {
+    WholeLineTracker tracker(kBlock, publish_all());
+    tracker.update(0, pieces, events);
+    return tracker.lines().size();
+  };
+  EXPECT_EQ(lines_with(&separate), 2u);  // the gap holds no events: two edges
+  EXPECT_EQ(lines_with(&one_edge), 1u);  // events run through it: one edge missing a segment
+  EXPECT_EQ(lines_with(nullptr), 1u);    // no lattice: geometry alone joins them
+
+  // Joined at one step, the two stay one line though the gap then holds no events (a line does not
+  // split for a moment without events).
+  WholeLineTracker tracker(kBlock, publish_all());
+  tracker.update(0, pieces, &one_edge);
+  tracker.update(1000, pieces, &separate);
+  EXPECT_EQ(tracker.lines().size(), 1u);
+}
+
 TEST(WholeLineTracker, RejectsStepsOutOfOrderAndABadBlockSize) {
   WholeLineTracker tracker(kBlock);
   tracker.update(10, {});

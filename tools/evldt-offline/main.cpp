@@ -87,7 +87,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     csv.write_step(t, lines.lines());
     frames.step(t, lines, lattice);
     if (!whole_csv) return;
-    joiner.update(t, lines.lines());
+    joiner.update(t, lines.lines(), &lattice);
     as_tracked_lines(joiner.lines(), joined);
     whole_csv->write_step(t, joined);
   });

@@ -169,10 +169,10 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
     }
     to.add_prediction(t, ids, predicted);
   };
-  pipeline.set_output(step_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
+  pipeline.set_output(step_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice& lattice) {
     add(evaluator, t, lines.lines());
     if (whole_lines == nullptr) return;
-    joiner.update(t, lines.lines());
+    joiner.update(t, lines.lines(), &lattice);
     as_tracked_lines(joiner.lines(), joined);
     predicted.swap(step_segments);  // the segments' geometry, which add() made, for the support
     add(*whole_lines, t, joined);

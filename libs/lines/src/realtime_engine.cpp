@@ -197,6 +197,11 @@ RealtimeEngine::LinesState RealtimeEngine::snapshot(std::vector<TrackedLine>& ou
   return {lines_time_us_, lines_version_.load(std::memory_order_relaxed)};
 }
 
+void RealtimeEngine::copy_lattice(ScarfLattice& view) const {
+  std::lock_guard lock(lattice_mutex_);
+  view.copy_state_from(lattice_);
+}
+
 std::vector<std::uint32_t> RealtimeEngine::masked_pixels() const {
   std::lock_guard lock(filter_mutex_);
   const auto masked = filters_.masked_pixels();

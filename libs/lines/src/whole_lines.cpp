@@ -44,8 +44,40 @@ bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float
     return false;
   }
   const float ta = a.dot(line.direction), tb = b.dot(line.direction);
-  const float gap = std::max({std::min(ta, tb) - line.t_max, line.t_min - std::max(ta, tb), 0.0f});
-  return gap <= relax * params_.max_gap_ratio * block_size_;
+  const float beyond_max = std::min(ta, tb) - line.t_max, before_min = line.t_min - std::max(ta, tb);
+  const float gap = std::max({beyond_max, before_min, 0.0f});
+  if (gap > relax * params_.max_gap_ratio * block_size_) return false;
+  // A segment that was this line's at the last step keeps its place without new evidence: the
+  // gap was crossed on evidence when it joined, and a line does not split for a step's missing events.
+  if (gap == 0 || relax > 1.0f) return true;
+  const Point2 end = line.point + (beyond_max > 0 ? line.t_max : line.t_min) * line.direction;
+  return bridged(end, end + (beyond_max > 0 ? gap : -gap) * line.direction);
+}
+
+bool WholeLineTracker::bridged(Point2 from, Point2 to) const {
+  const float length = (to - from).norm();
+  if (events_ == nullptr || !(length > params_.max_unsupported_gap_ratio * block_size_)) return true;
+  const LatticeGeometry& geometry = events_->geometry();
+  constexpr float kNearSquared = 1.5f * 1.5f;
+  const int samples = static_cast<int>(std::ceil(length));
+  int supported = 0;
+  for (int i = 0; i <= samples; ++i) {
+    const Point2 at = from + (to - from) * (static_cast<float>(i) / static_cast<float>(samples));
+    const int block = geometry.block_at(at.x(), at.y());
+    if (block < 0) continue;
+    // The block's extended region reaches b/2 beyond its active region: every event within 1.5 px
+    // of a point of the active region is among its entries.
+    const BlockEntries entries = events_->entries(block);
+    for (const LatticeEntry e : entries.entries) {
+      const float dx = static_cast<float>(entries.pixel_x(e)) - at.x();
+      const float dy = static_cast<float>(entries.pixel_y(e)) - at.y();
+      if (dx * dx + dy * dy <= kNearSquared) {
+        ++supported;
+        break;
+      }
+    }
+  }
+  return 2 * supported >= samples + 1;
 }
 
 std::uint64_t WholeLineTracker::previous_owner(std::uint64_t segment_id) const {
@@ -202,8 +234,9 @@ void WholeLineTracker::meet_at_corners() {
   }
 }
 
-void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments) {
+void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments, const ScarfLattice* events) {
   if (stepped_ && t < last_t_) throw std::invalid_argument("whole-line steps must come in time order");
+  events_ = events;
   stepped_ = true;
   last_t_ = t;
   const auto n = static_cast<std::uint32_t>(segments.size());
@@ -325,6 +358,7 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     return std::tuple(a.id == 0, a.id, a.key) < std::tuple(b.id == 0, b.id, b.key);
   });
   meet_at_corners();
+  events_ = nullptr;  // the caller's lattice is not kept past the step
 }
 
 void as_tracked_lines(std::span<const WholeLine> lines, std::vector<TrackedLine>& out) {

@@ -303,8 +303,11 @@ void LinesNode::publish_whole_lines(const std::shared_ptr<RealtimeEngine>& engin
     if (joiner_) next_whole_id_ += joiner_->created();
     joiner_.emplace(engine->geometry().block_size, engine->config().whole_lines, next_whole_id_);
     joined_engine_ = engine;
+    const LatticeParams& lattice = engine->config().lattice;
+    whole_view_.emplace(lattice.sensor, lattice.block_size, lattice.alpha);
   }
-  joiner_->update(lattice_us, lines_);
+  engine->copy_lattice(*whole_view_);  // the events gaps are checked against
+  joiner_->update(lattice_us, lines_, &*whole_view_);
   as_tracked_lines(joiner_->lines(), whole_);
   fill_segment_list(whole_, whole_msg_);
   whole_msg_.utime = list_msg_.utime;

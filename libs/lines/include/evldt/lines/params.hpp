@@ -66,6 +66,11 @@ struct WholeLineParams {
   /// the block at a corner holds two edges and fits neither, so both fall short of it). 0: off.
   float corner_reach_ratio = 2.0f;
   float corner_min_angle_deg = 30.0f;  ///< lines closer in direction than this do not make a corner
+  /// of b: a line takes in a new segment across a longer gap only where the lattice holds events
+  /// along the gap (when the tracker is given the lattice): half or more of its pixels with an event
+  /// within 1.5 px. Collinear edges of separate objects are apart by a gap without events; one edge
+  /// whose segment is missing somewhere is not.
+  float max_unsupported_gap_ratio = 0.5f;
 };
 
 struct PipelineConfig {

@@ -60,6 +60,9 @@ class RealtimeEngine {
   /// The pixels the hot-pixel filter masks now (y * width + x).
   [[nodiscard]] std::vector<std::uint32_t> masked_pixels() const;
   [[nodiscard]] const LatticeGeometry& geometry() const { return lattice_.geometry(); }
+  /// Brings `view`, a lattice of this engine's geometry, up to the stored one (copying only the
+  /// blocks changed since its last copy): the events a publisher's whole lines check gaps against.
+  void copy_lattice(ScarfLattice& view) const;
   [[nodiscard]] const PipelineConfig& config() const { return config_; }
   /// Folds a per-start epoch into line ids so a restarted process never repeats one.
   void set_first_line_id(std::uint64_t first);

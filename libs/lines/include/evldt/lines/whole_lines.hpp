@@ -12,6 +12,7 @@
 #include "evldt/lines/geometry.hpp"
 #include "evldt/lines/line_map.hpp"
 #include "evldt/lines/point_grid.hpp"
+#include "evldt/scarf/scarf_lattice.hpp"
 
 namespace evldt {
 
@@ -34,8 +35,10 @@ class WholeLineTracker {
   /// line's segments where they fit, which merges the two). A published line that finds none waits
   /// keep_id_us under its last geometry and may take segments up again; one never published ends.
   /// The segments left start new lines. An end its segments no longer reach stays where it was for
-  /// end_memory_us. Steps must come in time order.
-  void update(Timestamp t, std::span<const TrackedLine> segments);
+  /// end_memory_us. Steps must come in time order. With `events` (the lattice the segments were
+  /// tracked on), a line takes in a new segment across a gap longer than max_unsupported_gap_ratio * b
+  /// only where the lattice holds events along it; without, on geometry alone.
+  void update(Timestamp t, std::span<const TrackedLine> segments, const ScarfLattice* events = nullptr);
 
   /// The lines of the last step that are published: those holding segments now that reached
   /// min_length_ratio * b at some step. Ids are given on publication, so a line never published uses none.
@@ -73,6 +76,9 @@ class WholeLineTracker {
   /// within the bounds, times `relax` (2 for a segment that was part of this line at the last step:
   /// hysteresis, a line does not split for a step's wobble).
   [[nodiscard]] bool fits(const LineModel& line, const Segment& segment, float relax) const;
+  /// Whether the stretch from `from` to `to` may be bridged: it is short, or no lattice was given,
+  /// or half or more of its pixels have an event of the lattice within 1.5 px.
+  [[nodiscard]] bool bridged(Point2 from, Point2 to) const;
   /// The track key a segment belonged to at the last step, or 0.
   [[nodiscard]] std::uint64_t previous_owner(std::uint64_t segment_id) const;
   /// Adds segment `s` as a member of the last cluster and refits its direction and extent.
@@ -93,6 +99,7 @@ class WholeLineTracker {
 
   float block_size_;
   WholeLineParams params_;
+  const ScarfLattice* events_ = nullptr;  ///< of the current update(), or none
   float cell_size_;  ///< of the grid of segment ends
   float min_cos_angle_;
   float loose_cos_angle_;

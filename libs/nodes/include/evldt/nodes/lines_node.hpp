@@ -133,6 +133,7 @@ class LinesNode {
   std::atomic<std::uint64_t> lists_published_{0};
   std::optional<WholeLineTracker> joiner_;  ///< for the engine below (held, so a new one is told apart)
   std::shared_ptr<const RealtimeEngine> joined_engine_;
+  std::optional<ScarfLattice> whole_view_;  ///< the joined engine's lattice as of the last whole-line step
   std::uint64_t next_whole_id_;
   std::vector<TrackedLine> whole_;
   segment_list_t whole_msg_;
