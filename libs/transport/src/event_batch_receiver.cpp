@@ -68,7 +68,7 @@ bool EventBatchReceiver::admit() {
   const SequenceCounts before = sequence_.counts();
   if (!sequence_.observe(message_.epoch, message_.seq)) return false;
   restarted_ = sequence_.counts().restarts != before.restarts;
-  if (const std::uint64_t lost = sequence_.counts().lost; lost != before.lost && std::bit_floor(lost) > before.lost) {
+  if (const std::uint64_t lost = sequence_.counts().lost; std::bit_floor(lost) > before.lost) {
     // Batches the network or this host dropped before they were read (a socket buffer overflowing
     // while the host was busy, most often): the lattice missed their events.
     spdlog::warn("lost {} event batch(es) in all (sequence gaps; latest before seq {}): is net.core.rmem_max at least "

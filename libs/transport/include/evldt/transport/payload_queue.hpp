@@ -34,7 +34,6 @@ class PayloadQueue {
   /// Frees the slot of the payload front() returned.
   void pop();
 
-  [[nodiscard]] std::size_t capacity() const { return slots_.size(); }
   /// The most payloads queued at once so far.
   [[nodiscard]] std::size_t high_water() const;
 
