@@ -249,11 +249,12 @@ namespace {
 // A stream replayed at a tenth of real time: 0.5 ms of event time every 5 ms of wall time. The rounds
 // follow the event time (a tracking round per 2 ms of it, a detection round per 4 ms), not the wall
 // clock, which would ask for ten times as many; and when the input stops, a last round takes in the
-// last events without waiting for a period of event time.
-TEST(RealtimeEngine, RoundsFollowEventTimeNotWallTime) {
+// last events without waiting for a period of event time. With `shedding`, a batch was shed first.
+EngineCounters run_slowly(bool shedding) {
   const PipelineConfig config = default_config_for(kSensor);
   RealtimeEngine engine(config);
   engine.start();
+  if (shedding) engine.shed(0);
   const EventBatch events = vertical_sweep();
   constexpr Timestamp kSliceUs = 500, kEventTimeUs = 100'000;
   EventBatch chunk;
@@ -273,13 +274,29 @@ TEST(RealtimeEngine, RoundsFollowEventTimeNotWallTime) {
   }
   engine.stop();
   EXPECT_EQ(engine.snapshot(lines).lattice_us, last);  // the pause ran a round on the last events
-  const EngineCounters counters = engine.counters();
+  return engine.counters();
+}
+
+TEST(RealtimeEngine, RoundsFollowEventTimeNotWallTime) {
+  const EngineCounters counters = run_slowly(false);
   // 100 ms of event time: 50 tracking and 25 detection rounds on schedule, a few more where the input
   // paused (a slow machine's hiccup); rounds at the wall-time rate would be 500 and 250 over the 1 s.
   EXPECT_GE(counters.track_rounds, 30u);
   EXPECT_LE(counters.track_rounds, 80u);
   EXPECT_GE(counters.detect_rounds, 15u);
   EXPECT_LE(counters.detect_rounds, 50u);
+}
+
+// While batches are shed (the service is past its means) the rounds run shedding_period_factor
+// periods apart, for a second of event time after the last batch shed: the CPU goes to storage.
+TEST(RealtimeEngine, RoundsRunFurtherApartWhileShedding) {
+  ASSERT_EQ(default_config_for(kSensor).schedule.shedding_period_factor, 2);
+  const EngineCounters counters = run_slowly(true);
+  // 25 tracking and 12 detection rounds on the stretched schedule, a few more where the input paused.
+  EXPECT_GE(counters.track_rounds, 15u);
+  EXPECT_LE(counters.track_rounds, 40u);
+  EXPECT_GE(counters.detect_rounds, 8u);
+  EXPECT_LE(counters.detect_rounds, 25u);
 }
 
 }  // namespace

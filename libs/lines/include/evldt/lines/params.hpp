@@ -49,6 +49,10 @@ struct ScheduleParams {
   Timestamp detect_period_us = 4000;
   /// Event-time gaps longer than this many tracking periods are skipped rather than replayed round by round.
   int max_catch_up_rounds = 8;
+  /// The real-time engine, while it sheds batches over its latency budget: rounds this many periods
+  /// apart. Chosen at x1 on monitor-hd (docs/realtime.md): 2 sheds a third as many batches as 1,
+  /// 3 no fewer than 2 at a lower F@1%.
+  int shedding_period_factor = 2;
 };
 
 /// Joining block segments into whole lines (whole_lines.hpp). Chosen on boxes-10s: tighter joins

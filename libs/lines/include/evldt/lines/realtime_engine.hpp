@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <limits>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -98,6 +99,10 @@ class RealtimeEngine {
   std::uint64_t events_stored_ = 0;           // guarded by lattice_mutex_
   std::uint64_t events_received_ = 0;         // stored or filtered; guarded by lattice_mutex_
   Timestamp latest_event_us_ = 0;             // guarded by lattice_mutex_
+  static constexpr Timestamp kNeverShed = std::numeric_limits<Timestamp>::min();
+  // Rounds stay further apart until this much event time has passed without a batch shed.
+  static constexpr Timestamp kSheddingMemoryUs = 1'000'000;
+  Timestamp last_shed_us_ = kNeverShed;       // event time of the last batch shed; guarded by lattice_mutex_
   bool stopping_ = false;                     // guarded by lattice_mutex_
   std::atomic<bool> storing_{false};          // process() is running: a loop lets it copy the views
   LoopState detect_, track_;
