@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "evldt/lines/whole_lines.hpp"
@@ -312,6 +313,53 @@ TEST(WholeLineTracker, ANewSegmentAcrossAGapJoinsOnlyWhereTheLatticeHoldsEventsA
   tracker.update(0, pieces, &one_edge);
   tracker.update(1000, pieces, &separate);
   EXPECT_EQ(tracker.lines().size(), 1u);
+}
+
+// An L whose edges stop 10 px short of where they cross: with the lattice, they meet at the corner
+// only where events run from each end to it (two edges that only nearly meet make no corner).
+TEST(WholeLineTracker, LinesMeetAtACornerOnlyWhereTheEventsReachIt) {
+  std::vector<TrackedLine> corner = pieces_along(20, 8, 40, 1);
+  for (std::uint64_t k = 0; k < 4; ++k) {
+    corner.push_back(segment(11 + k, 50, 30 + 8.0f * static_cast<float>(k), 50, 38 + 8.0f * static_cast<float>(k)));
+  }
+  ScarfLattice short_of_it(SensorSize{128, 96}, kBlock, 2.0), to_the_corner(SensorSize{128, 96}, kBlock, 2.0);
+  for (std::uint16_t x = 8; x <= 50; ++x) {
+    if (x <= 40) short_of_it.insert(x, 20);
+    to_the_corner.insert(x, 20);
+  }
+  for (std::uint16_t y = 20; y <= 62; ++y) {
+    if (y >= 30) short_of_it.insert(50, y);
+    to_the_corner.insert(50, y);
+  }
+  const auto horizontal_end = [&](const ScarfLattice& events) {
+    WholeLineTracker tracker(kBlock);
+    tracker.update(0, corner, &events);
+    return max_x(line_holding(tracker, 20));
+  };
+  EXPECT_NEAR(horizontal_end(to_the_corner), 50.0f, 0.01f);
+  EXPECT_NEAR(horizontal_end(short_of_it), 40.0f, 0.01f);
+}
+
+// A remembered end stays only while the events still run to it: an edge whose end the events left
+// (it was cut short, or moved out of view) ends where its segments do.
+TEST(WholeLineTracker, ARememberedEndStaysOnlyWhileTheEventsRunToIt) {
+  ScarfLattice whole_edge(SensorSize{128, 64}, kBlock, 2.0), shorter(SensorSize{128, 64}, kBlock, 2.0);
+  for (std::uint16_t x = 4; x <= 52; ++x) {
+    whole_edge.insert(x, 20);
+    if (x >= 12 && x <= 44) shorter.insert(x, 20);
+  }
+  const auto ends_after_the_ends_drop_out = [&](const ScarfLattice& events) {
+    WholeLineTracker tracker(kBlock);
+    tracker.update(0, pieces_along(20, 4, 52, 1), &whole_edge);
+    tracker.update(10, pieces_along(20, 12, 44, 2), &events);
+    return std::pair(min_x(tracker.lines().at(0)), max_x(tracker.lines().at(0)));
+  };
+  const auto [kept_min, kept_max] = ends_after_the_ends_drop_out(whole_edge);
+  EXPECT_NEAR(kept_min, 4.0f, 0.1f);
+  EXPECT_NEAR(kept_max, 52.0f, 0.1f);
+  const auto [left_min, left_max] = ends_after_the_ends_drop_out(shorter);
+  EXPECT_NEAR(left_min, 12.0f, 0.1f);
+  EXPECT_NEAR(left_max, 44.0f, 0.1f);
 }
 
 TEST(WholeLineTracker, RejectsStepsOutOfOrderAndABadBlockSize) {

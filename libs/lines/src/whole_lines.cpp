@@ -54,30 +54,34 @@ bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float
   return bridged(end, end + (beyond_max > 0 ? gap : -gap) * line.direction);
 }
 
-bool WholeLineTracker::bridged(Point2 from, Point2 to) const {
+bool WholeLineTracker::bridged(Point2 from, Point2 to, float spread) const {
   const float length = (to - from).norm();
   if (events_ == nullptr || !(length > params_.max_unsupported_gap_ratio * block_size_)) return true;
   const LatticeGeometry& geometry = events_->geometry();
-  constexpr float kNearSquared = 1.5f * 1.5f;
   const int samples = static_cast<int>(std::ceil(length));
+  // Half of the samples 0..samples, rounded up; the loop ends as soon as the answer is known.
+  const int needed = (samples + 2) / 2;
   int supported = 0;
-  for (int i = 0; i <= samples; ++i) {
-    const Point2 at = from + (to - from) * (static_cast<float>(i) / static_cast<float>(samples));
+  for (int i = 0; i <= samples && supported < needed && supported + (samples + 1 - i) >= needed; ++i) {
+    const float along = static_cast<float>(i) / static_cast<float>(samples);
+    const Point2 at = from + (to - from) * along;
+    // The block's extended region reaches b/2 beyond its active region: every event within b/2 of a
+    // point of the active region is among its entries.
+    const float near = std::min(1.5f + spread * along * length, 0.5f * block_size_);
+    const float near_squared = near * near;
     const int block = geometry.block_at(at.x(), at.y());
     if (block < 0) continue;
-    // The block's extended region reaches b/2 beyond its active region: every event within 1.5 px
-    // of a point of the active region is among its entries.
     const BlockEntries entries = events_->entries(block);
     for (const LatticeEntry e : entries.entries) {
       const float dx = static_cast<float>(entries.pixel_x(e)) - at.x();
       const float dy = static_cast<float>(entries.pixel_y(e)) - at.y();
-      if (dx * dx + dy * dy <= kNearSquared) {
+      if (dx * dx + dy * dy <= near_squared) {
         ++supported;
         break;
       }
     }
   }
-  return 2 * supported >= samples + 1;
+  return supported >= needed;
 }
 
 std::uint64_t WholeLineTracker::previous_owner(std::uint64_t segment_id) const {
@@ -161,10 +165,11 @@ void WholeLineTracker::continue_track(Track& track, const Cluster& cluster, std:
   // Only while the line itself is where it was: a line that turned or moved has no ends to keep.
   const bool same_line = fits({next.point, next.direction, was_min, was_max}, was, 1.0f);
   const float reach = 0.5f * block_size_;
-  const bool remember_min =
-      same_line && next.t_min > was_min + reach && t - track.end_seen_us[0] <= params_.end_memory_us;
-  const bool remember_max =
-      same_line && next.t_max < was_max - reach && t - track.end_seen_us[1] <= params_.end_memory_us;
+  const auto at = [&](float along) -> Point2 { return next.point + along * next.direction; };
+  const bool remember_min = same_line && next.t_min > was_min + reach && t - track.end_seen_us[0] <= params_.end_memory_us &&
+                            bridged(at(next.t_min), at(was_min), params_.extension_spread);
+  const bool remember_max = same_line && next.t_max < was_max - reach && t - track.end_seen_us[1] <= params_.end_memory_us &&
+                            bridged(at(next.t_max), at(was_max), params_.extension_spread);
   if (remember_min) {
     next.t_min = was_min;
   } else {
@@ -202,6 +207,12 @@ void WholeLineTracker::meet_at_corners() {
     Segment& s = published_[end / 2].segment;
     return end % 2 == 0 ? s.q0 : s.q1;
   };
+  // An end that would grow to the corner does so only where the events reach it (a crossing of two
+  // edges that only nearly meet is no corner); one past the corner is always drawn back to it.
+  const auto reaches = [&](const Segment& line, std::uint32_t which_end, Point2 at) {
+    const Point2 end = which_end == 0 ? line.q0 : line.q1, other = which_end == 0 ? line.q1 : line.q0;
+    return (at - end).dot(end - other) <= 0 || bridged(end, at, params_.extension_spread);
+  };
   ends_.clear();
   for (std::uint32_t end = 0; end < 2 * published_.size(); ++end) ends_.push_back(end_point(end));
   // Two ends within reach of one corner are within 2 reach of each other: cells that wide, 3 x 3 of them.
@@ -218,6 +229,7 @@ void WholeLineTracker::meet_at_corners() {
       if (!(std::abs(sine) >= std::max(min_sin, 1e-6f))) return;  // also a zero-length line's NaN, and parallel lines
       const Point2 at = pa + (cross2(pb - pa, db) / sine) * da;
       if ((at - pa).norm() > reach || (at - pb).norm() > reach) return;
+      if (!reaches(line_a, a % 2, at) || !reaches(line_b, b % 2, at)) return;
       corners_.push_back({(at - pa).norm() + (at - pb).norm(), a, b, at});
     });
   }

@@ -77,8 +77,9 @@ class WholeLineTracker {
   /// hysteresis, a line does not split for a step's wobble).
   [[nodiscard]] bool fits(const LineModel& line, const Segment& segment, float relax) const;
   /// Whether the stretch from `from` to `to` may be bridged: it is short, or no lattice was given,
-  /// or half or more of its pixels have an event of the lattice within 1.5 px.
-  [[nodiscard]] bool bridged(Point2 from, Point2 to) const;
+  /// or half or more of its pixels have an event of the lattice within 1.5 px + spread * (distance
+  /// from `from`).
+  [[nodiscard]] bool bridged(Point2 from, Point2 to, float spread = 0) const;
   /// The track key a segment belonged to at the last step, or 0.
   [[nodiscard]] std::uint64_t previous_owner(std::uint64_t segment_id) const;
   /// Adds segment `s` as a member of the last cluster and refits its direction and extent.
