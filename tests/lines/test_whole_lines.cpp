@@ -135,6 +135,30 @@ TEST(WholeLineTracker, ARememberedEndDoesNotFollowALineThatTurned) {
   EXPECT_NEAR(tracker.lines()[0].segment.length(), 24.0f, 0.1f);
 }
 
+// A line takes its former segments back along its last geometry. Block segments along an edge at
+// -11 degrees, from boxes-6dof (each block's segment level, the edge a staircase of them); at the
+// next step the end block's segment tilts to -28 degrees and is the longest of them. Fitted to that
+// one first, the line refused the rest of its edge (24 degrees apart), which became a new line with
+// a new id; along its last geometry it keeps them all.
+TEST(WholeLineTracker, ATiltedLongestSegmentDoesNotSteerALineOffItsEdge) {
+  const auto edge = [](float y_end, float y_start) {
+    return std::vector<TrackedLine>{segment(538, 12, y_start, 20, y_end),   segment(392, 20, 41.1f, 28, 41.1f),
+                                    segment(368, 28, 39.7f, 36, 39.7f),     segment(314, 36, 38.0f, 44, 38.8f),
+                                    segment(308, 44, 36.5f, 52, 36.5f),     segment(282, 52, 34.9f, 60, 34.9f),
+                                    segment(450, 60, 33.1f, 68, 33.1f)};
+  };
+  WholeLineTracker tracker(kBlock);
+  tracker.update(0, edge(42.9f, 44.0f));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  const std::uint64_t id = tracker.lines()[0].id;
+  tracker.update(10, edge(41.3f, 45.6f));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.lines()[0].id, id);
+  EXPECT_GE(tracker.lines()[0].segments, 6u);
+  EXPECT_LE(min_x(tracker.lines()[0]), 20.0f);
+  EXPECT_GE(max_x(tracker.lines()[0]), 60.0f);
+}
+
 TEST(WholeLineTracker, OfASplitLineTheLongerPartKeepsTheId) {
   WholeLineTracker tracker(kBlock);
   tracker.update(0, pieces_along(20, 4, 68, 1));  // ids 1-8

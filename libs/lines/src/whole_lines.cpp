@@ -16,6 +16,9 @@ constexpr std::uint32_t kUnassigned = std::numeric_limits<std::uint32_t>::max();
 constexpr std::uint64_t kNoKey = 0;
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 constexpr float kLooseJoin = 2.0f;  // hysteresis: bounds for segments that were already one line
+// Of b: a line taking back its former segments fits its own direction to them once they span this
+// much (chosen on boxes-6dof and boxes-10s; 4 b did as well there and worse on flicker-lamps).
+constexpr float kOwnFitRatio = 2.0f;
 
 }  // namespace
 
@@ -291,7 +294,13 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     auto it = std::lower_bound(owned_.begin(), owned_.end(), std::pair(track.key, std::uint32_t{0}),
                                [](const auto& a, const auto& b) { return a.first < b.first; });
     for (; it != owned_.end() && it->first == track.key; ++it) {
-      if (cluster_of_segment_[it->second] == kUnassigned && fits(cluster.model, segments[it->second].segment, kLooseJoin)) {
+      // Its former segments are taken back along its last geometry until those taken back span
+      // enough to fit a direction of their own: a short end segment taken back first would else steer
+      // the line off its edge, leave the rest to a younger line and hand that line the edge's id.
+      const bool own_fit = members_.size() > cluster.first_member &&
+                           cluster.model.t_max - cluster.model.t_min >= kOwnFitRatio * block_size_;
+      if (cluster_of_segment_[it->second] == kUnassigned &&
+          fits(own_fit ? cluster.model : track.model, segments[it->second].segment, kLooseJoin)) {
         add_member(cluster, it->second, segments);
       }
     }
