@@ -295,8 +295,9 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
                                [](const auto& a, const auto& b) { return a.first < b.first; });
     for (; it != owned_.end() && it->first == track.key; ++it) {
       // Its former segments are taken back along its last geometry until those taken back span
-      // enough to fit a direction of their own: a short end segment taken back first would else steer
-      // the line off its edge, leave the rest to a younger line and hand that line the edge's id.
+      // enough to fit a direction of their own: one tilted segment taken back first (the longest,
+      // at a corner) would else steer the line off its edge and leave the rest, and with it the
+      // edge's id, to a younger line.
       const bool own_fit = members_.size() > cluster.first_member &&
                            cluster.model.t_max - cluster.model.t_min >= kOwnFitRatio * block_size_;
       if (cluster_of_segment_[it->second] == kUnassigned &&

@@ -3,10 +3,12 @@
 // while detection and tracking loop on their own threads, each starting a round once a period of
 // event time has been stored since its last (or, when the input pauses, on whatever is new). So
 // the rounds follow the events: a stream replayed at a tenth of real time costs a tenth of the
-// rounds. Each loop works on its own copy of the lattice, brought up to date before each round (by
-// the storing thread when the loop asks while a batch is being stored), so storage never waits for
-// a pass, nor for a copy by a preempted thread of lower priority, and a round always starts from
-// the newest state: rounds never queue. The loops run at the process's priority (evldt-lines raises
+// rounds; while the caller sheds batches it cannot store in time, the rounds run
+// ScheduleParams::shedding_period_factor periods apart, leaving the CPU to storage. Each loop works
+// on its own copy of the lattice, brought up to date before each round (by the storing thread when
+// the loop asks while a batch is being stored), so storage never waits for a pass, nor for a copy
+// by a preempted thread of lower priority, and a round always starts from the newest state: rounds
+// never queue. The loops run at the process's priority (evldt-lines raises
 // storage's above it). The line state is shared by the two loops under a second lock.
 
 #include <atomic>

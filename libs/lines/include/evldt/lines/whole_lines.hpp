@@ -36,8 +36,9 @@ class WholeLineTracker {
   /// keep_id_us under its last geometry and may take segments up again; one never published ends.
   /// The segments left start new lines. An end its segments no longer reach stays where it was for
   /// end_memory_us. Steps must come in time order. With `events` (the lattice the segments were
-  /// tracked on), a line takes in a new segment across a gap longer than max_unsupported_gap_ratio * b
-  /// only where the lattice holds events along it; without, on geometry alone.
+  /// tracked on), a line reaches beyond its segments only where the lattice holds events along the
+  /// stretch: across a gap longer than max_unsupported_gap_ratio * b to a new segment, to a corner,
+  /// to a remembered end; without, on geometry alone.
   void update(Timestamp t, std::span<const TrackedLine> segments, const ScarfLattice* events = nullptr);
 
   /// The lines of the last step that are published: those holding segments now that reached
