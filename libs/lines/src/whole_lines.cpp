@@ -211,10 +211,11 @@ void WholeLineTracker::meet_at_corners() {
     return end % 2 == 0 ? s.q0 : s.q1;
   };
   // An end that would grow to the corner does so only where the events reach it (a crossing of two
-  // edges that only nearly meet is no corner); one past the corner is always drawn back to it.
-  const auto reaches = [&](const Segment& line, std::uint32_t which_end, Point2 at) {
-    const Point2 end = which_end == 0 ? line.q0 : line.q1, other = which_end == 0 ? line.q1 : line.q0;
-    return (at - end).dot(end - other) <= 0 || bridged(end, at, params_.extension_spread);
+  // edges that only nearly meet is no corner); one past the corner is always drawn back to it. Of
+  // the lines as they were before any end moved (ends_).
+  const auto reaches = [&](std::uint32_t end, Point2 at) {
+    const Point2 from = ends_[end], other = ends_[end ^ 1];
+    return (at - from).dot(from - other) <= 0 || bridged(from, at, params_.extension_spread);
   };
   ends_.clear();
   for (std::uint32_t end = 0; end < 2 * published_.size(); ++end) ends_.push_back(end_point(end));
@@ -232,17 +233,18 @@ void WholeLineTracker::meet_at_corners() {
       if (!(std::abs(sine) >= std::max(min_sin, 1e-6f))) return;  // also a zero-length line's NaN, and parallel lines
       const Point2 at = pa + (cross2(pb - pa, db) / sine) * da;
       if ((at - pa).norm() > reach || (at - pb).norm() > reach) return;
-      if (!reaches(line_a, a % 2, at) || !reaches(line_b, b % 2, at)) return;
       corners_.push_back({(at - pa).norm() + (at - pb).norm(), a, b, at});
     });
   }
-  // Nearest corners first; an end meets one corner.
+  // Nearest corners first; an end meets one corner. The events are asked only of the corners that
+  // would be made (the lattice check is the costly part): one they refuse leaves both ends free.
   std::sort(corners_.begin(), corners_.end(), [](const Corner& x, const Corner& y) {
     return x.cost != y.cost ? x.cost < y.cost : std::pair(x.end_a, x.end_b) < std::pair(y.end_a, y.end_b);
   });
   end_moved_.assign(2 * published_.size(), 0);
   for (const Corner& corner : corners_) {
     if (end_moved_[corner.end_a] != 0 || end_moved_[corner.end_b] != 0) continue;
+    if (!reaches(corner.end_a, corner.at) || !reaches(corner.end_b, corner.at)) continue;
     end_moved_[corner.end_a] = end_moved_[corner.end_b] = 1;
     end_point(corner.end_a) = corner.at;
     end_point(corner.end_b) = corner.at;
