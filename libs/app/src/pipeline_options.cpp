@@ -37,6 +37,9 @@ void PipelineOptions::add_to(CLI::App& app) {
       ->check(finite_number() & CLI::Range(0.01, 1.0));
   group->add_option("--fit-iterations", fit_iterations_, "Robust reweighting rounds of the line fit")
       ->check(CLI::Range(0, 20));
+  group->add_option("--max-bend", max_bend_,
+                    "Detection: no line where the events beyond both of its ends bend off to one side by this fraction of b (an arc; 0: off)")
+      ->check(finite_number() & CLI::Range(0.0, 2.0));
   group->add_option("--perturbation", perturbation_, "Endpoint perturbation dq in pixels")
       ->check(finite_number() & CLI::Range(0.01, 20.0));
   group->add_option("--bad-track-patience-us", bad_track_patience_,
@@ -119,6 +122,7 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   if (fit_threshold_) config.score.fit_threshold = *fit_threshold_;
   if (inlier_ratio_) config.score.inlier_distance_ratio = *inlier_ratio_;
   if (fit_iterations_) config.score.fit_iterations = *fit_iterations_;
+  if (max_bend_) config.score.max_bend_ratio = *max_bend_;
   if (perturbation_) config.track.perturbation_px = *perturbation_;
   if (bad_track_patience_) config.track.bad_track_patience_us = *bad_track_patience_;
   if (reassociation_window_) config.track.reassociation.window_us = *reassociation_window_;

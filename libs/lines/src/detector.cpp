@@ -18,7 +18,7 @@ LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& p
   const float b = static_cast<float>(geometry.block_size);
   workers_.reserve(static_cast<std::size_t>(threads));
   for (int w = 0; w < threads; ++w) {
-    Worker& worker = workers_.emplace_back(Worker{FittingScorer(params.inlier_distance_ratio * b, b * 1.5f), {}});
+    Worker& worker = workers_.emplace_back(Worker{FittingScorer(params.inlier_distance_ratio * b, b * 1.5f), BendTest(geometry, params.max_bend_ratio), {}});
     worker.points.reserve(static_cast<std::size_t>(geometry.capacity));
   }
   failed_at_.assign(static_cast<std::size_t>(geometry.block_count()), kNeverFailed);
@@ -81,7 +81,7 @@ void LineDetector::detect_row(const ScarfLattice& lattice, LineMap& lines, int r
     const auto segment = clip_to_square(*line, geometry_.origin_x(column), geometry_.origin_y(row), b);
     if (!segment) continue;
     const float f = worker.scorer.score(*segment, worker.points, capacity).score();
-    if (f > params_.fit_threshold) {
+    if (f > params_.fit_threshold && !worker.bend.bent(lattice, *segment)) {
       found_[static_cast<std::size_t>(block)] = {true, f, *segment};
       failed_at_[block] = kNeverFailed;
     }

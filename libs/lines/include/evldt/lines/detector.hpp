@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "evldt/lines/bend_test.hpp"
 #include "evldt/lines/fitting_score.hpp"
 #include "evldt/lines/line_map.hpp"
 #include "evldt/lines/params.hpp"
@@ -30,6 +31,7 @@ class LineDetector {
   /// One worker's scratch.
   struct Worker {
     FittingScorer scorer;
+    BendTest bend;
     PointSet points;  // the active entries of the current block
   };
   /// A block's new line of this round, until it is added.
