@@ -38,7 +38,7 @@ void PipelineOptions::add_to(CLI::App& app) {
   group->add_option("--fit-iterations", fit_iterations_, "Robust reweighting rounds of the line fit")
       ->check(CLI::Range(0, 20));
   group->add_option("--max-bend", max_bend_,
-                    "Detection: no line where the events beyond both of its ends bend off to one side by this fraction of b (an arc; 0: off)")
+                    "Detection: no line where the events beyond both of its ends bend off to one side by this fraction of b, at least 2 px (an arc; 0: off)")
       ->check(finite_number() & CLI::Range(0.0, 2.0));
   group->add_option("--perturbation", perturbation_, "Endpoint perturbation dq in pixels")
       ->check(finite_number() & CLI::Range(0.01, 20.0));

@@ -24,8 +24,8 @@ struct ScoreParams {
   float fit_threshold = 0.2f;          ///< f_th: a line is kept while its fitting score f > f_th
   float inlier_distance_ratio = 0.2f;  ///< d_max = ratio * b
   int fit_iterations = 3;              ///< robust (Fair-weighted) reweighting rounds after the first PCA fit
-  /// of b: a block's line is not detected where the events run on beyond both of its ends and bend
-  /// away to one side by this much over the span (an arc: bend_test.hpp). 0: off.
+  /// of b (at least 2 px): a block's line is not detected where the events run on beyond both of its
+  /// ends and bend away to one side by this much over the span (an arc: bend_test.hpp). 0: off.
   float max_bend_ratio = 0.1f;
 };
 
