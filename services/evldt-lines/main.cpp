@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
         "  shed      %llu batches, %llu events: later than the %.0f ms latency budget, not stored\n"
         "  events    %llu received, %llu stored, %llu dropped as invalid (%llu off sensor, %llu back in time), %llu clock resets\n"
         "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
-        "  loops     %llu detection rounds, %llu tracking rounds\n"
+        "  loops     %llu detection rounds (%llu while shedding, without the bend test), %llu tracking rounds\n"
         "  output    %llu lines created, %llu segment lists published, %llu whole-line lists (%llu at %g Hz while shedding)\n"
         "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches); settled, from 1 s after\n"
         "            the first batch: median %.1f ms, p99 %.1f ms (%u batches)\n",
@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
         static_cast<unsigned long long>(t.receiver.drops.clock_resets), static_cast<unsigned long long>(t.filtered.hot_pixel),
         static_cast<unsigned long long>(t.filtered.background_activity), static_cast<unsigned long long>(t.filtered.refractory),
         static_cast<unsigned long long>(t.filtered.anti_flicker), static_cast<unsigned long long>(t.detect_rounds),
+        static_cast<unsigned long long>(t.detect_rounds_without_bend_test),
         static_cast<unsigned long long>(t.track_rounds), static_cast<unsigned long long>(t.lines_created),
         static_cast<unsigned long long>(t.lists_published), static_cast<unsigned long long>(t.whole_lists_published),
         static_cast<unsigned long long>(t.whole_lists_while_shedding), options.whole_lines_loaded_hz, t.latency.median_ms, t.latency.p99_ms, t.latency.samples,

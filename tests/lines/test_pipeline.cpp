@@ -285,10 +285,12 @@ TEST(RealtimeEngine, RoundsFollowEventTimeNotWallTime) {
   EXPECT_LE(counters.track_rounds, 80u);
   EXPECT_GE(counters.detect_rounds, 15u);
   EXPECT_LE(counters.detect_rounds, 50u);
+  EXPECT_EQ(counters.detect_rounds_without_bend_test, 0u);
 }
 
 // While batches are shed (the service is past its means) the rounds run shedding_period_factor
-// periods apart, for a second of event time after the last batch shed: the CPU goes to storage.
+// periods apart, for a second of event time after the last batch shed, and detection skips the
+// bend test: the CPU goes to storage.
 TEST(RealtimeEngine, RoundsRunFurtherApartWhileShedding) {
   ASSERT_EQ(default_config_for(kSensor).schedule.shedding_period_factor, 2);
   const EngineCounters counters = run_slowly(true);
@@ -297,6 +299,7 @@ TEST(RealtimeEngine, RoundsRunFurtherApartWhileShedding) {
   EXPECT_LE(counters.track_rounds, 40u);
   EXPECT_GE(counters.detect_rounds, 8u);
   EXPECT_LE(counters.detect_rounds, 25u);
+  EXPECT_EQ(counters.detect_rounds_without_bend_test, counters.detect_rounds);
 }
 
 }  // namespace

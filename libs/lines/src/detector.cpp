@@ -25,7 +25,7 @@ LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& p
   found_.resize(static_cast<std::size_t>(geometry.block_count()));
 }
 
-int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now) {
+int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now, bool test_bends) {
   if (lattice.versions_of() != versions_of_) {  // another lattice: its versions mean nothing here
     versions_of_ = lattice.versions_of();
     std::fill(failed_at_.begin(), failed_at_.end(), kNeverFailed);
@@ -35,7 +35,7 @@ int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp 
     Worker& worker = workers_[static_cast<std::size_t>(w)];
     for (int row = next_row.fetch_add(1, std::memory_order_relaxed); row < geometry_.blocks_y;
          row = next_row.fetch_add(1, std::memory_order_relaxed)) {
-      detect_row(lattice, lines, row, worker);
+      detect_row(lattice, lines, row, worker, test_bends);
     }
   };
   if (pool_ != nullptr && geometry_.block_count() >= kMinBlocksToSplit) {
@@ -56,7 +56,7 @@ int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp 
   return created;
 }
 
-void LineDetector::detect_row(const ScarfLattice& lattice, LineMap& lines, int row, Worker& worker) {
+void LineDetector::detect_row(const ScarfLattice& lattice, LineMap& lines, int row, Worker& worker, bool test_bends) {
   const float b = static_cast<float>(geometry_.block_size);
   const float capacity = static_cast<float>(geometry_.capacity);
   for (int column = 0; column < geometry_.blocks_x; ++column) {
@@ -81,7 +81,7 @@ void LineDetector::detect_row(const ScarfLattice& lattice, LineMap& lines, int r
     const auto segment = clip_to_square(*line, geometry_.origin_x(column), geometry_.origin_y(row), b);
     if (!segment) continue;
     const float f = worker.scorer.score(*segment, worker.points, capacity).score();
-    if (f > params_.fit_threshold && !worker.bend.bent(lattice, *segment)) {
+    if (f > params_.fit_threshold && !(test_bends && worker.bend.bent(lattice, *segment))) {
       found_[static_cast<std::size_t>(block)] = {true, f, *segment};
       failed_at_[block] = kNeverFailed;
     }

@@ -44,11 +44,16 @@ void RealtimeEngine::start() {
   }
   detect_thread_ = std::thread([this] {
     loop("evldt-detect", detect_, detect_rounds_, config_.schedule.detect_period_us,
-         [this](const ScarfLattice& view, Timestamp now) { detector_.detect(view, lines_, now); });
+         [this](const ScarfLattice& view, Timestamp now, bool shedding) {
+           // While shedding, new lines skip the bend test (at x1 on monitor-hd it is a tenth of a
+           // core: docs/realtime.md): arcs may be taken for lines until the load eases.
+           detector_.detect(view, lines_, now, /*test_bends=*/!shedding);
+           if (shedding) detect_rounds_without_bend_test_.fetch_add(1, std::memory_order_relaxed);
+         });
   });
   track_thread_ = std::thread([this] {
     loop("evldt-track", track_, track_rounds_, config_.schedule.track_period_us,
-         [this](const ScarfLattice& view, Timestamp now) { tracker_.track(view, lines_, now); });
+         [this](const ScarfLattice& view, Timestamp now, bool /*shedding*/) { tracker_.track(view, lines_, now); });
   });
 }
 
@@ -184,7 +189,7 @@ void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic
     next_due = now + (shed_lately ? config_.schedule.shedding_period_factor * period_us : period_us);
     {
       std::lock_guard lock(lines_mutex_);
-      round(state.view, now);
+      round(state.view, now, shed_lately);
       lines_time_us_ = std::max(lines_time_us_, now);
       lines_version_.fetch_add(1, std::memory_order_release);
     }
@@ -232,6 +237,7 @@ EngineCounters RealtimeEngine::counters() const {
     c.lines_created = lines_.created();
   }
   c.detect_rounds = detect_rounds_.load(std::memory_order_relaxed);
+  c.detect_rounds_without_bend_test = detect_rounds_without_bend_test_.load(std::memory_order_relaxed);
   c.track_rounds = track_rounds_.load(std::memory_order_relaxed);
   return c;
 }

@@ -168,6 +168,7 @@ void LinesNode::start_engine() {
   retired_.events_received += retired.events_received;
   retired_.filtered += retired.filtered;
   retired_.detect_rounds += retired.detect_rounds;
+  retired_.detect_rounds_without_bend_test += retired.detect_rounds_without_bend_test;
   retired_.track_rounds += retired.track_rounds;
   retired_.lines_created += retired.lines_created;
 }
@@ -383,6 +384,7 @@ LinesNodeTotals LinesNode::totals() const {
     totals.events_received = retired_.events_received;
     totals.filtered = retired_.filtered;
     totals.detect_rounds = retired_.detect_rounds;
+    totals.detect_rounds_without_bend_test = retired_.detect_rounds_without_bend_test;
     totals.track_rounds = retired_.track_rounds;
     totals.lines_created = retired_.lines_created;
     totals.latency = latency_.run_summary();
@@ -394,6 +396,7 @@ LinesNodeTotals LinesNode::totals() const {
     totals.events_received += counters.events_received;
     totals.filtered += counters.filtered;
     totals.detect_rounds += counters.detect_rounds;
+    totals.detect_rounds_without_bend_test += counters.detect_rounds_without_bend_test;
     totals.track_rounds += counters.track_rounds;
     totals.lines_created += counters.lines_created;
   }

@@ -21,8 +21,10 @@ class LineDetector {
   /// must outlive the detector.
   LineDetector(const LatticeGeometry& geometry, const ScoreParams& params, WorkerPool* pool = nullptr);
 
-  /// One detection round over every block; returns the number of lines created.
-  int detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now);
+  /// One detection round over every block; returns the number of lines created. Without
+  /// `test_bends` a block's line that clears the score is kept without the bend test (the live
+  /// engine while it sheds: the test reads the blocks beyond both ends of every new line).
+  int detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now, bool test_bends = true);
 
   /// A lattice of fewer blocks is detected on the calling thread: waking the pool would cost more.
   static constexpr int kMinBlocksToSplit = 1024;
@@ -40,7 +42,7 @@ class LineDetector {
     float score = 0;
     Segment segment;
   };
-  void detect_row(const ScarfLattice& lattice, LineMap& lines, int row, Worker& worker);
+  void detect_row(const ScarfLattice& lattice, LineMap& lines, int row, Worker& worker, bool test_bends);
 
   LatticeGeometry geometry_;
   ScoreParams params_;

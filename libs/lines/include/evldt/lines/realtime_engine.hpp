@@ -4,7 +4,8 @@
 // event time has been stored since its last (or, when the input pauses, on whatever is new). So
 // the rounds follow the events: a stream replayed at a tenth of real time costs a tenth of the
 // rounds; while the caller sheds batches it cannot store in time, the rounds run
-// ScheduleParams::shedding_period_factor periods apart, leaving the CPU to storage. Each loop works
+// ScheduleParams::shedding_period_factor periods apart, leaving the CPU to storage, and detection
+// keeps new lines without the bend test (bend_test.hpp). Each loop works
 // on its own copy of the lattice, brought up to date before each round (by the storing thread when
 // the loop asks while a batch is being stored), so storage never waits for a pass, nor for a copy
 // by a preempted thread of lower priority, and a round always starts from the newest state: rounds
@@ -29,6 +30,7 @@ struct EngineCounters {
   std::uint64_t events_received = 0;  ///< handed to process()
   std::uint64_t events = 0;           ///< stored
   std::uint64_t detect_rounds = 0;
+  std::uint64_t detect_rounds_without_bend_test = 0;  ///< those run while shedding
   std::uint64_t track_rounds = 0;
   std::uint64_t lines_created = 0;
   Timestamp latest_event_us = 0;
@@ -118,7 +120,7 @@ class RealtimeEngine {
   std::atomic<std::uint64_t> lines_version_{0};  // written under lines_mutex_
   mutable std::condition_variable round_done_;   // with lines_mutex_
 
-  std::atomic<std::uint64_t> detect_rounds_{0}, track_rounds_{0};
+  std::atomic<std::uint64_t> detect_rounds_{0}, track_rounds_{0}, detect_rounds_without_bend_test_{0};
   std::thread detect_thread_, track_thread_;
 };
 

@@ -57,6 +57,7 @@ struct LinesNodeTotals {
   FilterCounts filtered;              ///< what the noise filters dropped of them
   std::uint64_t events_stored = 0;
   std::uint64_t detect_rounds = 0;
+  std::uint64_t detect_rounds_without_bend_test = 0;  ///< run while shedding
   std::uint64_t track_rounds = 0;
   std::uint64_t lines_created = 0;
   std::uint64_t lists_published = 0;
