@@ -19,6 +19,8 @@
 #include "evldt/eval/whole_line_support.hpp"
 #include "evldt/lines/segment_csv.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
+#include "evldt/eval/frame_ground_truth.hpp"
+#include "evldt/frames/frame_reader.hpp"
 #include "evldt/transport/lcm_log.hpp"
 
 namespace {
@@ -26,7 +28,8 @@ namespace {
 using namespace evldt;
 
 struct Options {
-  std::filesystem::path segments, whole_lines, ground_truth, json, pr_png, lifetime_png, tracks_png;
+  std::filesystem::path segments, whole_lines, ground_truth, frames_gt, json, pr_png, lifetime_png, tracks_png;
+  LsdParams lsd;
   std::string lcm_channel;
   std::vector<double> tolerances{0.01, 0.02};
   std::vector<float> pr_thresholds;
@@ -88,11 +91,24 @@ std::optional<std::pair<Timestamp, Timestamp>> recorded_event_span(const std::fi
 
 // The rule is StreamEvaluator's: every ground-truth step, against the latest predicted step at or
 // before it within 1.5 output periods.
+// The ground truth: LSD on the frames of --frames-gt (as the paper), else the scene's or the CSV's
+// exact lines.
+GroundTruthSteps ground_truth_steps(const Options& options, const SimulatorOptions& sim, SensorSize sensor) {
+  if (!options.frames_gt.empty()) {
+    const auto frames = open_ecd_frames(options.frames_gt, sensor);
+    GroundTruthSteps truth = frame_ground_truth_steps(*frames, options.lsd);
+    spdlog::info("ground truth: LSD on {} frames of {} (segments of {} px or more)", truth.times.size(), options.frames_gt.string(),
+                 options.lsd.min_length_px);
+    return truth;
+  }
+  return sim.scene_selected() ? scene_ground_truth_steps(sim.scene(), options.step_us)
+                              : csv_ground_truth_steps(read_ground_truth_csv(options.ground_truth));
+}
+
 StreamEvaluator evaluate_files(const Options& options, std::vector<SegmentRow> rows, SensorSize sensor,
                                const SimulatorOptions& sim) {
   const bool from_log = is_lcm_log(options.segments);
-  GroundTruthSteps truth = sim.scene_selected() ? scene_ground_truth_steps(sim.scene(), options.step_us)
-                                                : csv_ground_truth_steps(read_ground_truth_csv(options.ground_truth));
+  GroundTruthSteps truth = ground_truth_steps(options, sim, sensor);
   if (from_log) {
     if (const auto span = recorded_event_span(options.segments, options.lcm_channel)) {
       const std::size_t before = truth.times.size();
@@ -248,7 +264,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     spdlog::error("--whole-lines is scored against the segments of the same run: give --segments too");
     return 1;
   }
-  if (!options.whole_lines.empty() && options.ground_truth.empty() && !sim.scene_selected()) {
+  if (!options.whole_lines.empty() && options.ground_truth.empty() && options.frames_gt.empty() && !sim.scene_selected()) {
     // No ground truth: the support alone (a real recording).
     const SupportSummary support = file_support(read_segments(options), options.whole_lines);
     print_support(options.whole_lines.filename().string(), support);
@@ -264,8 +280,8 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     return 0;
   }
   if (!options.segments.empty()) {
-    if (options.ground_truth.empty() == !sim.scene_selected()) {
-      spdlog::error("with --segments give the ground truth: --ground-truth FILE or --scene NAME");
+    if (options.frames_gt.empty() && options.ground_truth.empty() == !sim.scene_selected()) {
+      spdlog::error("with --segments give the ground truth: --ground-truth FILE, --scene NAME or --frames-gt FOLDER");
       return 1;
     }
     const auto sensor = sim.scene_selected() ? std::optional<SensorSize>(sim.scene().sensor) : pipeline_options.sensor();
@@ -295,12 +311,14 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     const PipelineConfig base = pipeline_options.resolve(scene.sensor);
     std::vector<float> thresholds = options.pr_thresholds;
     if (thresholds.empty()) thresholds.push_back(base.score.fit_threshold);
+    const GroundTruthSteps truth = ground_truth_steps(options, sim, scene.sensor);
+    const Timestamp hold_us = std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(options.step_us));
     for (const float threshold : thresholds) {
       PipelineConfig config = base;
       config.score.fit_threshold = threshold;
       const auto started = std::chrono::steady_clock::now();
-      last.emplace(make_scene_evaluator(scene, options.tolerances, options.step_us));
-      StreamEvaluator whole = make_scene_evaluator(scene, options.tolerances, options.step_us);
+      last.emplace(scene.sensor, options.tolerances, truth, hold_us);
+      StreamEvaluator whole(scene.sensor, options.tolerances, truth, hold_us);
       const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, result.events, wall);
@@ -317,6 +335,22 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
         write_run_plots(options, *evaluator, r, thresholds.size() > 1);
         reports.push_back(r);
       }
+    }
+    if (!options.frames_gt.empty()) {
+      // How good the imitation is: LSD's lines on the frames, scored against the scene's exact lines.
+      const Timestamp frame_hold_us =
+          std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(median_step_spacing(truth.times)));
+      StreamEvaluator lsd(scene.sensor, options.tolerances, scene_ground_truth_steps(scene, options.step_us), frame_hold_us);
+      std::vector<Segment> segments;
+      std::vector<std::uint64_t> ids;
+      for (std::size_t i = 0; i < truth.times.size(); ++i) {
+        truth.segments_at(i, segments, ids);
+        lsd.add_prediction(truth.times[i], ids, segments);
+      }
+      lsd.finish();
+      Report r = make_report(lsd);
+      r.label = scene.name + " lsd/exact";
+      reports.push_back(r);
     }
   }
   print_table(reports, options);
@@ -357,6 +391,13 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--lcm-channel", options.lcm_channel, "Segment channel of an lcm-log (default: the first LINES_*)");
   app.add_option("--ground-truth", options.ground_truth, "Ground-truth CSV (from evldt-sim)")->check(CLI::ExistingFile);
+  app.add_option("--frames-gt", options.frames_gt,
+                 "Ground truth as the paper makes it: LSD on the intensity frames of this ECD folder (images.txt and "
+                 "images/; evldt-sim --frames-hz writes one), in place of the exact lines")
+      ->check(CLI::ExistingPath);
+  app.add_option("--lsd-min-length", options.lsd.min_length_px, "With --frames-gt: LSD segments shorter than this (px) are dropped")
+      ->capture_default_str()
+      ->check(finite_number() & CLI::Range(0.0, 10000.0));
   sim_options.add_to(app, /*scene_required=*/false);
   app.add_option("--tolerance", options.tolerances, "Match tolerances as fractions of the diagonal")
       ->capture_default_str()

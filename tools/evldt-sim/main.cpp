@@ -9,6 +9,7 @@
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/simulator_options.hpp"
 #include "evldt/events/event_writer.hpp"
+#include "evldt/frames/frame_writer.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
 #include "evldt/sim/scenes.hpp"
 
@@ -32,7 +33,7 @@ std::filesystem::path file_for(EventFormat format) {
 }
 
 int run(const SimulatorOptions& sim_options, const std::filesystem::path& out_dir, const std::vector<std::string>& formats,
-        Timestamp gt_period_us, bool quiet) {
+        Timestamp gt_period_us, double frames_hz, bool quiet) {
   const Scene scene = sim_options.scene();
   std::filesystem::create_directories(out_dir);
   std::vector<std::unique_ptr<EventWriter>> writers;
@@ -64,6 +65,20 @@ int run(const SimulatorOptions& sim_options, const std::filesystem::path& out_di
   }
   for (auto& writer : writers) writer->close();
   ground_truth.close();
+  int frames = 0;
+  if (frames_hz > 0) {
+    // The frames an APS would take at frames_hz, pixel-aligned with the events (ECD layout).
+    EcdFrameWriter frame_writer(out_dir);
+    std::vector<std::uint8_t> grey;
+    const double period_us = 1e6 / frames_hz;
+    for (; static_cast<double>(frames) * period_us <= static_cast<double>(scene.duration_us); ++frames) {
+      const auto t = static_cast<Timestamp>(std::llround(static_cast<double>(frames) * period_us));
+      simulator.render_frame(t, grey);
+      frame_writer.write(t, cv::Mat(scene.sensor.height, scene.sensor.width, CV_8UC1, grey.data()));
+    }
+    frame_writer.close();
+    written.push_back(frame_writer.list_path());
+  }
 
   const double seconds = static_cast<double>(scene.duration_us) * 1e-6;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -75,7 +90,8 @@ int run(const SimulatorOptions& sim_options, const std::filesystem::path& out_di
               static_cast<unsigned long long>(events), static_cast<double>(events) * 1e-6 / seconds,
               static_cast<unsigned long long>(c.signal_events), static_cast<unsigned long long>(c.noise_events),
               static_cast<unsigned long long>(c.refractory_losses), static_cast<unsigned long long>(c.readout_losses));
-  std::printf("  rendering        %llu sub-frames in %.2f s wall\n", static_cast<unsigned long long>(c.sub_frames), wall);
+  std::printf("  rendering        %llu sub-frames in %.2f s wall; %d frames at %g Hz\n", static_cast<unsigned long long>(c.sub_frames),
+              wall, frames, frames_hz);
   for (const auto& path : written) std::printf("  wrote            %s\n", path.string().c_str());
   return 0;
 }
@@ -84,11 +100,13 @@ int run(const SimulatorOptions& sim_options, const std::filesystem::path& out_di
 
 int main(int argc, char** argv) {
   CLI::App app{"evldt-sim: simulate an event camera watching a built-in scene; writes event recordings and the\n"
-               "ground-truth line segments (ground_truth.csv: t_us,gt_id,x0,y0,x1,y1) into a directory."};
+               "ground-truth line segments (ground_truth.csv: t_us,gt_id,x0,y0,x1,y1) into a directory, and with\n"
+               "--frames-hz the scene's grey frames (images.txt, images/)."};
   SimulatorOptions sim_options;
   std::filesystem::path out_dir = "sim-out";
   std::vector<std::string> formats{"evt3", "ecd"};
   Timestamp gt_period_us = 10000;
+  double frames_hz = 0;
   bool quiet = false;
   bool list = false;
   sim_options.add_to(app, /*scene_required=*/true);
@@ -99,10 +117,15 @@ int main(int argc, char** argv) {
   app.add_option("--gt-period-us", gt_period_us, "Event time between ground-truth rows")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{100}, Timestamp{10'000'000}));
+  app.add_option("--frames-hz", frames_hz,
+                 "Also write grey frames of the scene at this rate (images.txt and images/, the ECD layout), pixel-aligned "
+                 "with the events, for evldt-eval --frames-gt (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10000.0));
   app.add_flag("--list", list, "List the built-in scenes and exit");
   app.add_flag("-q,--quiet", quiet, "No progress lines");
   return run_main(app, argc, argv, [&] {
-    if (!list) return run(sim_options, out_dir, formats, gt_period_us, quiet);
+    if (!list) return run(sim_options, out_dir, formats, gt_period_us, frames_hz, quiet);
     for (const auto& name : scene_names()) {
       const Scene s = make_scene(name);
       std::printf("%-18s %dx%d  %.2f s  %zu shapes%s\n", name.c_str(), s.sensor.width, s.sensor.height,

@@ -69,12 +69,22 @@ EventSimulator::EventSimulator(Scene scene, const SimulatorConfig& config)
   next_hot_s_ = hot_total > 0 ? random_.exponential(1.0 / hot_total) : 1e300;
 }
 
-void EventSimulator::render(Timestamp t_us, std::vector<float>& log_image) {
+void EventSimulator::render(Timestamp t_us, std::vector<float>& log_image) const {
   const double t = static_cast<double>(t_us) * 1e-6;
   std::fill(log_image.begin(), log_image.end(), log_intensity(scene_.background));
   for (std::size_t k = 0; k < scene_.shapes.size(); ++k) {
     const Shape& shape = scene_.shapes[k];
     fill_convex(scene_.polygon_at(k, t), log_intensity(shape.brightness * shape.flicker.factor_at(t_us)), width_, height_, log_image);
+  }
+}
+
+void EventSimulator::render_frame(Timestamp t_us, std::vector<std::uint8_t>& grey) const {
+  std::vector<float> log_image(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_));
+  render(t_us, log_image);
+  grey.resize(log_image.size());
+  for (std::size_t i = 0; i < log_image.size(); ++i) {
+    const double brightness = std::clamp(std::exp(static_cast<double>(log_image[i])) - kDarkCurrent, 0.0, 1.0);
+    grey[i] = static_cast<std::uint8_t>(std::lround(brightness * 255.0));
   }
 }
 

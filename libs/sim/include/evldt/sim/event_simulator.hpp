@@ -52,12 +52,16 @@ class EventSimulator {
   /// follow the scene, not the calls, so any split of the time range gives the same events.
   bool run_until(Timestamp until_us, EventBatch& out);
 
+  /// The scene at `t_us` as an 8-bit grey frame (row-major, the sensor's size), brightness 0..1 to
+  /// 0..255: what a DAVIS's APS would see, pixel-aligned with the events. Any time, in any order.
+  void render_frame(Timestamp t_us, std::vector<std::uint8_t>& grey) const;
+
   [[nodiscard]] Timestamp now_us() const { return now_; }
   [[nodiscard]] const Scene& scene() const { return scene_; }
   [[nodiscard]] const SimulatorCounters& counters() const { return counters_; }
 
  private:
-  void render(Timestamp t_us, std::vector<float>& log_image);
+  void render(Timestamp t_us, std::vector<float>& log_image) const;
   Timestamp next_step();
   void emit_signal(Timestamp t0, Timestamp t1);
   void emit_noise(Timestamp t0, Timestamp t1);

@@ -1,0 +1,46 @@
+#pragma once
+// Intensity frames a recording holds beside its events (a DAVIS's APS frames, a simulator's
+// renderings), pixel-aligned with the events: the ground truth the paper draws lines from (issue 28).
+// A reader per container, behind one interface, as the event readers are; today the Event Camera
+// Dataset's folder layout.
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "evldt/events/event.hpp"
+
+namespace evldt {
+
+/// One frame: 8-bit grey, the sensor's size.
+struct Frame {
+  Timestamp t_us = 0;  ///< exposure time stamp, on the events' clock
+  cv::Mat image;       ///< CV_8UC1, sensor.height x sensor.width
+  std::string name;    ///< where it came from, for messages (the image file)
+};
+
+/// A frame that cannot be used: the message names the frame and the reason. Nothing is scored
+/// from a source once it has thrown.
+class FrameError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class FrameReader {
+ public:
+  virtual ~FrameReader() = default;
+  /// The next frame in time order, nullopt at the end; throws FrameError for a frame that is
+  /// missing, unreadable, of another size than the sensor, or earlier than the one before.
+  virtual std::optional<Frame> next() = 0;
+};
+
+/// The Event Camera Dataset's layout: `images.txt` (lines "t_seconds images/frame_00000000.png",
+/// paths relative to its folder) and the images. `path` is the folder or its images.txt. Throws
+/// FrameError when there is no images.txt.
+std::unique_ptr<FrameReader> open_ecd_frames(const std::filesystem::path& path, SensorSize sensor);
+
+}  // namespace evldt
