@@ -135,6 +135,14 @@ echo "ok: empty prediction -> P n/a, R 0, F 0; one step -> recall $one_step_reca
 lsd_f=$(awk '$2 == "lsd/exact" { print $6 }' "$work/frames.txt")
 awk -v f="$lsd_f" 'BEGIN { exit !(f > 0.9) }' || fail "LSD on the frames against the exact lines: $(cat "$work/frames.txt")"
 grep -q "ground truth: LSD on 21 frames" "$work/frames.err" || fail "frames ground truth not announced: $(cat "$work/frames.err")"
+# The same lines written out (--write-gt) score a segment file as the frames do; the paper's view per second.
+"$offline" "$work/frames/events.txt" --width 640 --height 480 -q --output-period-us 10000 -o "$work/frames_seg.csv" >/dev/null
+"$eval" --segments "$work/frames_seg.csv" --frames-gt "$work/frames" --width 640 --height 480 --write-gt "$work/lsd_gt.csv" \
+  --per-second >"$work/by_frames.txt" 2>/dev/null
+"$eval" --segments "$work/frames_seg.csv" --ground-truth "$work/lsd_gt.csv" --width 640 --height 480 >"$work/by_csv.txt" 2>/dev/null
+[[ $(grep '^frames_seg.csv' "$work/by_frames.txt" | head -1) == $(grep '^frames_seg.csv' "$work/by_csv.txt") ]] ||
+  fail "--write-gt CSV and --frames-gt score differently: $(cat "$work/by_frames.txt" "$work/by_csv.txt")"
+grep -Eq '^frames_seg.csv +1 s 0\.[0-9]{3} / 0\.[0-9]{3}$' "$work/by_frames.txt" || fail "--per-second: $(cat "$work/by_frames.txt")"
 sed -i '5s/frame_00000004/frame_missing/' "$work/frames/images.txt"
 set +e
 "$eval" --scene three-lines-fast --duration-s 0.2 --frames-gt "$work/frames" >"$work/frames_bad.txt" 2>&1

@@ -334,6 +334,28 @@ TEST(StreamEvaluator, OneStepOfPredictionIsHeldForOnePeriodAndRecallIsOverAllSte
   EXPECT_EQ(coverage.predicted_steps_scored, 1u);
 }
 
+// The paper's view: counts summed up to each second. Steps at 0, 0.5, 1.5, 2 and 2.5 s, the same
+// line each; it is predicted exactly in the first second only.
+TEST(StreamEvaluator, CumulativePerSecondSumsTheStepsUpToEachSecond) {
+  GroundTruthSteps truth;
+  truth.times = {0, 500'000, 1'500'000, 2'000'000, 2'500'000};
+  truth.segments_at = [](std::size_t, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments.assign(1, moving_line(0));
+    ids.assign(1, 3);
+  };
+  StreamEvaluator evaluator(kSensor, {0.01}, truth, 100'000);
+  predict(evaluator, 0, 1, {moving_line(0)});
+  predict(evaluator, 500'000, 1, {moving_line(0)});
+  evaluator.finish();
+  const std::vector<Prf> seconds = evaluator.cumulative_per_second();
+  ASSERT_EQ(seconds.size(), 3u);  // 0 and 0.5 s in the first, 1.5 and 2 s in the second, 2.5 s in the third
+  EXPECT_DOUBLE_EQ(seconds[0].recall, 1.0);
+  EXPECT_DOUBLE_EQ(seconds[1].recall, 2.0 / 4.0);
+  EXPECT_DOUBLE_EQ(seconds[2].recall, 2.0 / 5.0);
+  EXPECT_DOUBLE_EQ(seconds[2].precision, 1.0);
+  EXPECT_DOUBLE_EQ(seconds[2].recall, evaluator.accuracy().summed_prf(0).recall);
+}
+
 TEST(StreamEvaluator, APredictionThatLagsOnePeriodIsScoredAgainstTheTruthOfItsStep) {
   // The prediction stamped t shows the truth of t - 10: every step compares a line with the one 2 px
   // above it, and step 0 has nothing yet.

@@ -28,7 +28,7 @@ namespace {
 using namespace evldt;
 
 struct Options {
-  std::filesystem::path segments, whole_lines, ground_truth, frames_gt, json, pr_png, lifetime_png, tracks_png;
+  std::filesystem::path segments, whole_lines, ground_truth, frames_gt, write_gt, json, pr_png, lifetime_png, tracks_png;
   LsdParams lsd;
   std::string lcm_channel;
   std::vector<double> tolerances{0.01, 0.02};
@@ -36,6 +36,7 @@ struct Options {
   Timestamp step_us = 10000;
   Timestamp output_period_us = 0;  ///< of a segment file; 0: its median step spacing
   double histogram_bin_ms = 50;
+  bool per_second = false;
 };
 
 struct Report {
@@ -50,6 +51,7 @@ struct Report {
   LifetimeSummary lifetime;
   TrackingSummary tracking;
   std::optional<SupportSummary> support;  ///< whole lines: their support by the segments of their step
+  std::vector<Prf> per_second;            ///< cumulative, at the first tolerance
   std::uint64_t events = 0;
   double scene_seconds = 0, wall_seconds = 0;
 };
@@ -65,6 +67,7 @@ Report make_report(const StreamEvaluator& evaluator) {
   r.hold_us = evaluator.hold_us();
   r.lifetime = evaluator.lifetimes().summary();
   r.tracking = evaluator.tracking().summary();
+  r.per_second = evaluator.cumulative_per_second();
   return r;
 }
 
@@ -93,16 +96,37 @@ std::optional<std::pair<Timestamp, Timestamp>> recorded_event_span(const std::fi
 // before it within 1.5 output periods.
 // The ground truth: LSD on the frames of --frames-gt (as the paper), else the scene's or the CSV's
 // exact lines.
+// --write-gt: the steps as a ground-truth CSV, so that other methods are scored on the same lines.
+void write_ground_truth(const GroundTruthSteps& truth, const std::filesystem::path& path) {
+  GroundTruthCsvWriter out(path);
+  std::vector<Segment> segments;
+  std::vector<std::uint64_t> ids;
+  std::vector<GtSegment> rows;
+  for (std::size_t i = 0; i < truth.times.size(); ++i) {
+    truth.segments_at(i, segments, ids);
+    rows.clear();
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      rows.push_back({static_cast<int>(ids[k]), segments[k].q0.cast<double>(), segments[k].q1.cast<double>()});
+    }
+    out.write_step(truth.times[i], rows);
+  }
+  out.close();
+  spdlog::info("wrote the ground truth ({} steps) to {}", truth.times.size(), path.string());
+}
+
 GroundTruthSteps ground_truth_steps(const Options& options, const SimulatorOptions& sim, SensorSize sensor) {
+  GroundTruthSteps truth;
   if (!options.frames_gt.empty()) {
     const auto frames = open_ecd_frames(options.frames_gt, sensor);
-    GroundTruthSteps truth = frame_ground_truth_steps(*frames, options.lsd);
+    truth = frame_ground_truth_steps(*frames, options.lsd);
     spdlog::info("ground truth: LSD on {} frames of {} (segments of {} px or more)", truth.times.size(), options.frames_gt.string(),
                  options.lsd.min_length_px);
-    return truth;
+  } else {
+    truth = sim.scene_selected() ? scene_ground_truth_steps(sim.scene(), options.step_us)
+                                 : csv_ground_truth_steps(read_ground_truth_csv(options.ground_truth));
   }
-  return sim.scene_selected() ? scene_ground_truth_steps(sim.scene(), options.step_us)
-                              : csv_ground_truth_steps(read_ground_truth_csv(options.ground_truth));
+  if (!options.write_gt.empty()) write_ground_truth(truth, options.write_gt);
+  return truth;
 }
 
 StreamEvaluator evaluate_files(const Options& options, std::vector<SegmentRow> rows, SensorSize sensor,
@@ -189,6 +213,19 @@ SupportSummary file_support(const std::vector<SegmentRow>& segment_rows, const s
   return support.summary();
 }
 
+// The paper's view: precision / recall summed over the steps up to each second, the first 10.
+void print_per_second(const std::vector<Report>& reports, const Options& options) {
+  constexpr std::size_t kSeconds = 10;
+  std::printf("cumulative P / R at %.3g%% of the diagonal, up to each second:\n", options.tolerances.front() * 100);
+  for (const Report& r : reports) {
+    std::printf("%-26s", r.label.c_str());
+    for (std::size_t k = 0; k < std::min(kSeconds, r.per_second.size()); ++k) {
+      std::printf("  %zu s %.3f / %.3f", k + 1, r.per_second[k].precision, r.per_second[k].recall);
+    }
+    std::printf("\n");
+  }
+}
+
 void write_json(const std::vector<Report>& reports, const Options& options) {
   std::ofstream out(options.json);
   if (!out) throw std::runtime_error("cannot create " + options.json.string());
@@ -213,6 +250,11 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
     for (std::size_t i = 0; i < r.summed.size(); ++i) {
       json.begin_object().key("tolerance").value(options.tolerances[i]).key("precision").value(r.summed[i].precision);
       json.key("recall").value(r.summed[i].recall).key("f").value(r.summed[i].f).end_object();
+    }
+    json.end_array();
+    json.key("cumulative_per_second").begin_array();
+    for (const Prf& p : r.per_second) {
+      json.begin_object().key("precision").value(p.precision).key("recall").value(p.recall).key("f").value(p.f).end_object();
     }
     json.end_array();
     json.key("mean_segments_per_step").value(r.mean_predicted).key("mean_gt_segments_per_step").value(r.mean_ground_truth);
@@ -357,6 +399,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   for (const Report& r : reports) {
     if (r.support) print_support(r.label, *r.support);
   }
+  if (options.per_second) print_per_second(reports, options);
   if (!options.json.empty()) write_json(reports, options);
   if (!options.pr_png.empty()) {
     std::vector<PrPoint> points;
@@ -395,6 +438,12 @@ int main(int argc, char** argv) {
                  "Ground truth as the paper makes it: LSD on the intensity frames of this ECD folder (images.txt and "
                  "images/; evldt-sim --frames-hz writes one), in place of the exact lines")
       ->check(CLI::ExistingPath);
+  app.add_option("--write-gt", options.write_gt,
+                 "Write the ground truth scored against (LSD's lines with --frames-gt) as a CSV like evldt-sim's "
+                 "(t_us,gt_id,x0,y0,x1,y1), for --ground-truth of other runs");
+  app.add_flag("--per-second", options.per_second,
+               "Also print the paper's view: precision and recall summed up to each second, over the first 10 s (the JSON "
+               "has every second)");
   app.add_option("--lsd-min-length", options.lsd.min_length_px, "With --frames-gt: LSD segments shorter than this (px) are dropped")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.0, 10000.0));

@@ -88,8 +88,22 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
     ground_truth_.segments_at(next_step_, truth_, truth_ids_);
     for (std::size_t i = 0; i < matchers_.size(); ++i) counts_[i] = matchers_[i].match(predicted, truth_);
     accuracy_.add_step(counts_, predicted.size(), truth_.size());
-    tracking_.add_step(times[next_step_], predicted_ids, predicted, truth_ids_, truth_);
+    const Timestamp t = times[next_step_];
+    const auto second = static_cast<std::size_t>(t > 0 ? (t - 1) / 1'000'000 : 0);
+    if (per_second_.size() <= second) per_second_.resize(second + 1);
+    per_second_[second] += counts_[0];
+    tracking_.add_step(t, predicted_ids, predicted, truth_ids_, truth_);
   }
+}
+
+std::vector<Prf> StreamEvaluator::cumulative_per_second() const {
+  std::vector<Prf> cumulative;
+  MatchCounts sum;
+  for (const MatchCounts& second : per_second_) {
+    sum += second;
+    cumulative.push_back(prf(sum));
+  }
+  return cumulative;
 }
 
 void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted) {

@@ -65,6 +65,10 @@ class StreamEvaluator {
   /// Tracking metrics, at the first tolerance.
   [[nodiscard]] const TrackingEvaluator& tracking() const { return tracking_; }
   [[nodiscard]] const StepCoverage& coverage() const { return coverage_; }
+  /// The paper's view, at the first tolerance: element k - 1 is the P/R/F of the counts summed over
+  /// the ground-truth steps up to k seconds (a step at t_us belongs to second ceil(t / 1 s), t = 0
+  /// to the first), for each second up to the last step's.
+  [[nodiscard]] std::vector<Prf> cumulative_per_second() const;
   [[nodiscard]] Timestamp hold_us() const { return hold_us_; }
   [[nodiscard]] const GroundTruthSteps& ground_truth() const { return ground_truth_; }
 
@@ -76,6 +80,7 @@ class StreamEvaluator {
   EvaluationAccumulator accuracy_;
   LifetimeTracker lifetimes_;
   TrackingEvaluator tracking_;
+  std::vector<MatchCounts> per_second_;  // first tolerance, by second of the step time
   GroundTruthSteps ground_truth_;
   Timestamp hold_us_;
   std::size_t next_step_ = 0;
