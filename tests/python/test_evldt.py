@@ -263,3 +263,25 @@ def test_lcm_log_reader_stops_with_a_format_error_on_a_cut_log(tmp_path):
     log.write_bytes(record + b"garbage that is no record")
     with pytest.raises(evldt.FormatError, match="no record starts here|ends inside"):
         list(evldt.read_lcm_log(log))
+
+
+def _write_pgm(path, image):
+    path.write_bytes(b"P5 %d %d 255\n" % (image.shape[1], image.shape[0]) + image.tobytes())
+
+
+def test_read_frames_gives_the_images_of_an_ecd_folder_and_names_a_bad_one(tmp_path):
+    (tmp_path / "images").mkdir()
+    first = np.arange(48 * 64, dtype=np.uint8).reshape(48, 64)
+    second = np.full((48, 64), 200, dtype=np.uint8)
+    _write_pgm(tmp_path / "images" / "a.pgm", first)
+    _write_pgm(tmp_path / "images" / "b.pgm", second)
+    (tmp_path / "images.txt").write_text("0.001 images/a.pgm\n0.0115 images/b.pgm\n")
+    frames = evldt.read_frames(tmp_path, 64, 48)
+    assert [t for t, _ in frames] == [1000, 11500]
+    assert frames[0][1].dtype == np.uint8 and frames[0][1].shape == (48, 64)
+    assert np.array_equal(frames[0][1], first) and np.array_equal(frames[1][1], second)
+    with pytest.raises(evldt.FrameError, match="a.pgm is 64x48, the sensor 32x24"):
+        evldt.read_frames(tmp_path, 32, 24)
+    (tmp_path / "images.txt").write_text("0.001 images/a.pgm\n0.002 images/gone.pgm\n")
+    with pytest.raises(ValueError, match="images.txt:2: frame .*gone.pgm is missing"):
+        evldt.read_frames(tmp_path, 64, 48)

@@ -17,15 +17,15 @@ from collections import namedtuple
 
 import numpy as np
 
-from ._evldt import (EVENT_DTYPE, GROUND_TRUTH_DTYPE, SEGMENT_DTYPE, FormatError, Reader)
+from ._evldt import (EVENT_DTYPE, GROUND_TRUTH_DTYPE, SEGMENT_DTYPE, FormatError, FrameError, Reader)
 from . import _evldt
 from .event_batch_t import event_batch_t
 from .line_segment_t import line_segment_t
 from .segment_list_t import segment_list_t
 from .stats_t import stats_t
 
-__all__ = ["read", "read_chunks", "read_lcm_log", "Recording", "Pipeline", "evaluate", "simulate", "Simulation", "EVENT_DTYPE",
-           "SEGMENT_DTYPE", "GROUND_TRUTH_DTYPE", "STATUS_NAMES", "FormatError", "event_batch_t",
+__all__ = ["read", "read_chunks", "read_frames", "read_lcm_log", "Recording", "Pipeline", "evaluate", "simulate", "Simulation",
+           "EVENT_DTYPE", "SEGMENT_DTYPE", "GROUND_TRUTH_DTYPE", "STATUS_NAMES", "FormatError", "FrameError", "event_batch_t",
            "line_segment_t", "segment_list_t", "stats_t"]
 
 #: SEGMENT_DTYPE's status codes.
@@ -138,6 +138,14 @@ def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), out
         truth[field] = ground_truth[field]
     return _evldt.evaluate(predicted, truth, int(width), int(height), [float(t) for t in tolerances],
                            int(output_period_us))
+
+
+def read_frames(path, width, height):
+    """The intensity frames of a folder in the Event Camera Dataset's layout (images.txt and images/;
+    evldt-sim --frames-hz writes one): a list of (t_us, image), image a height x width uint8 array,
+    in time order. A frame that is missing, unreadable, of another size or out of time order raises
+    FrameError (a ValueError) naming it."""
+    return _evldt.read_frames(str(path), int(width), int(height))
 
 
 def simulate(scene, gt_period_us=10_000, **options):

@@ -23,6 +23,7 @@
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/simulator_options.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
+#include "evldt/frames/frame_reader.hpp"
 #include "evldt/events/event_validator.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/sources/event_source.hpp"
@@ -332,6 +333,20 @@ py::tuple simulate(const std::vector<std::string>& flags, Timestamp gt_period_us
   return py::make_tuple(events_to_numpy(events), to_numpy(truth), scene.sensor.width, scene.sensor.height);
 }
 
+// The frames of an ECD folder as (t_us, HxW uint8 array) pairs; FrameError names a bad frame.
+py::list read_frames(const std::string& path, int width, int height) {
+  const auto reader = open_ecd_frames(path, SensorSize{width, height});
+  py::list frames;
+  while (auto frame = reader->next()) {
+    py::array_t<std::uint8_t> image({frame->image.rows, frame->image.cols});
+    for (int row = 0; row < frame->image.rows; ++row) {
+      std::memcpy(image.mutable_data(row, 0), frame->image.ptr(row), static_cast<std::size_t>(frame->image.cols));
+    }
+    frames.append(py::make_tuple(frame->t_us, image));
+  }
+  return frames;
+}
+
 }  // namespace
 }  // namespace evldt::python
 
@@ -344,6 +359,7 @@ PYBIND11_MODULE(_evldt, m) {
   PYBIND11_NUMPY_DTYPE(GroundTruthRecord, t, gt_id, x0, y0, x1, y1);
   // A corrupt recording: what the tools print as the error, after the valid prefix was returned.
   py::register_exception<FormatError>(m, "FormatError", PyExc_ValueError);
+  py::register_exception<FrameError>(m, "FrameError", PyExc_ValueError);
 
   m.attr("EVENT_DTYPE") = py::dtype::of<EventRecord>();
   m.attr("SEGMENT_DTYPE") = py::dtype::of<SegmentRecord>();
@@ -367,4 +383,5 @@ PYBIND11_MODULE(_evldt, m) {
   m.def("evaluate", &evaluate, py::arg("segments"), py::arg("ground_truth"), py::arg("width"), py::arg("height"),
         py::arg("tolerances"), py::arg("output_period_us"));
   m.def("simulate", &simulate, py::arg("flags"), py::arg("gt_period_us"));
+  m.def("read_frames", &read_frames, py::arg("path"), py::arg("width"), py::arg("height"));
 }
