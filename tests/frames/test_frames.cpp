@@ -122,14 +122,8 @@ TEST_F(FramesTest, LsdOnSimulatedFramesMatchesTheExactLines) {
   const auto frames = open_ecd_frames(folder_, scene.sensor);
   const GroundTruthSteps lsd = frame_ground_truth_steps(*frames, LsdParams{});
   ASSERT_EQ(lsd.times.size(), 11u);
-  StreamEvaluator evaluator(scene.sensor, {0.01}, scene_ground_truth_steps(scene, 20'000), 30'000);
-  std::vector<Segment> segments;
-  std::vector<std::uint64_t> ids;
-  for (std::size_t i = 0; i < lsd.times.size(); ++i) {
-    lsd.segments_at(i, segments, ids);
-    evaluator.add_prediction(lsd.times[i], ids, segments);
-  }
-  evaluator.finish();
+  const StreamEvaluator evaluator = evaluate_steps_against(lsd, scene_ground_truth_steps(scene, 20'000), scene.sensor, {0.01});
+  EXPECT_EQ(evaluator.hold_us(), 30'000);
   EXPECT_GT(evaluator.accuracy().summed_prf(0).f, 0.9);
 }
 

@@ -380,16 +380,8 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     }
     if (!options.frames_gt.empty()) {
       // How good the imitation is: LSD's lines on the frames, scored against the scene's exact lines.
-      const Timestamp frame_hold_us =
-          std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(median_step_spacing(truth.times)));
-      StreamEvaluator lsd(scene.sensor, options.tolerances, scene_ground_truth_steps(scene, options.step_us), frame_hold_us);
-      std::vector<Segment> segments;
-      std::vector<std::uint64_t> ids;
-      for (std::size_t i = 0; i < truth.times.size(); ++i) {
-        truth.segments_at(i, segments, ids);
-        lsd.add_prediction(truth.times[i], ids, segments);
-      }
-      lsd.finish();
+      const StreamEvaluator lsd =
+          evaluate_steps_against(truth, scene_ground_truth_steps(scene, options.step_us), scene.sensor, options.tolerances);
       Report r = make_report(lsd);
       r.label = scene.name + " lsd/exact";
       reports.push_back(r);

@@ -159,6 +159,20 @@ StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthS
   return evaluator;
 }
 
+StreamEvaluator evaluate_steps_against(const GroundTruthSteps& predicted, GroundTruthSteps truth, SensorSize sensor,
+                                       std::vector<double> tolerance_fractions) {
+  const Timestamp hold_us = std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(median_step_spacing(predicted.times)));
+  StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth), hold_us);
+  std::vector<Segment> segments;
+  std::vector<std::uint64_t> ids;
+  for (std::size_t i = 0; i < predicted.times.size(); ++i) {
+    predicted.segments_at(i, segments, ids);
+    evaluator.add_prediction(predicted.times[i], ids, segments);
+  }
+  evaluator.finish();
+  return evaluator;
+}
+
 StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tolerance_fractions, Timestamp step_us) {
   return StreamEvaluator(scene.sensor, std::move(tolerance_fractions), scene_ground_truth_steps(scene, step_us),
                          std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(step_us)));

@@ -122,6 +122,12 @@ struct SceneRunResult {
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
                               Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines = nullptr);
 
+/// One ground truth's steps scored as the prediction against another's (LSD on frames against the
+/// exact lines: how good the imitation is), each predicted step held for kHoldPeriods of their
+/// median spacing.
+StreamEvaluator evaluate_steps_against(const GroundTruthSteps& predicted, GroundTruthSteps truth, SensorSize sensor,
+                                       std::vector<double> tolerance_fractions);
+
 /// The evaluator evaluate_scene expects for a scene.
 StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tolerance_fractions, Timestamp step_us);
 
