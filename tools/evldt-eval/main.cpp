@@ -13,14 +13,14 @@
 
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/simulator_options.hpp"
+#include "evldt/eval/frame_ground_truth.hpp"
 #include "evldt/eval/json.hpp"
 #include "evldt/eval/plots.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/eval/whole_line_support.hpp"
+#include "evldt/frames/frame_reader.hpp"
 #include "evldt/lines/segment_csv.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
-#include "evldt/eval/frame_ground_truth.hpp"
-#include "evldt/frames/frame_reader.hpp"
 #include "evldt/transport/lcm_log.hpp"
 
 namespace {
@@ -92,10 +92,6 @@ std::optional<std::pair<Timestamp, Timestamp>> recorded_event_span(const std::fi
   }
 }
 
-// The rule is StreamEvaluator's: every ground-truth step, against the latest predicted step at or
-// before it within 1.5 output periods.
-// The ground truth: LSD on the frames of --frames-gt (as the paper), else the scene's or the CSV's
-// exact lines.
 // --write-gt: the steps as a ground-truth CSV, so that other methods are scored on the same lines.
 void write_ground_truth(const GroundTruthSteps& truth, const std::filesystem::path& path) {
   GroundTruthCsvWriter out(path);
@@ -114,6 +110,8 @@ void write_ground_truth(const GroundTruthSteps& truth, const std::filesystem::pa
   spdlog::info("wrote the ground truth ({} steps) to {}", truth.times.size(), path.string());
 }
 
+// The ground truth: LSD on the frames of --frames-gt (as the paper), else the scene's or the CSV's
+// exact lines.
 GroundTruthSteps ground_truth_steps(const Options& options, const SimulatorOptions& sim, SensorSize sensor) {
   GroundTruthSteps truth;
   if (!options.frames_gt.empty()) {
@@ -129,6 +127,8 @@ GroundTruthSteps ground_truth_steps(const Options& options, const SimulatorOptio
   return truth;
 }
 
+// The rule is StreamEvaluator's: every ground-truth step, against the latest predicted step at or
+// before it within 1.5 output periods.
 StreamEvaluator evaluate_files(const Options& options, std::vector<SegmentRow> rows, SensorSize sensor,
                                const SimulatorOptions& sim) {
   const bool from_log = is_lcm_log(options.segments);
@@ -354,7 +354,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     std::vector<float> thresholds = options.pr_thresholds;
     if (thresholds.empty()) thresholds.push_back(base.score.fit_threshold);
     const GroundTruthSteps truth = ground_truth_steps(options, sim, scene.sensor);
-    const Timestamp hold_us = std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(options.step_us));
+    const Timestamp hold_us = StreamEvaluator::hold_for_period(options.step_us);
     for (const float threshold : thresholds) {
       PipelineConfig config = base;
       config.score.fit_threshold = threshold;

@@ -141,8 +141,7 @@ StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthS
   }
   Timestamp period = output_period_us > 0 ? output_period_us : median_step_spacing(times);
   if (period == 0) period = median_step_spacing(truth.times);  // fewer than two predicted steps
-  StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth),
-                            std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(period)));
+  StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth), StreamEvaluator::hold_for_period(period));
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted;
   for (std::size_t i = 0; i < rows.size();) {
@@ -161,8 +160,8 @@ StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthS
 
 StreamEvaluator evaluate_steps_against(const GroundTruthSteps& predicted, GroundTruthSteps truth, SensorSize sensor,
                                        std::vector<double> tolerance_fractions) {
-  const Timestamp hold_us = std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(median_step_spacing(predicted.times)));
-  StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth), hold_us);
+  StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth),
+                            StreamEvaluator::hold_for_period(median_step_spacing(predicted.times)));
   std::vector<Segment> segments;
   std::vector<std::uint64_t> ids;
   for (std::size_t i = 0; i < predicted.times.size(); ++i) {
@@ -175,7 +174,7 @@ StreamEvaluator evaluate_steps_against(const GroundTruthSteps& predicted, Ground
 
 StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tolerance_fractions, Timestamp step_us) {
   return StreamEvaluator(scene.sensor, std::move(tolerance_fractions), scene_ground_truth_steps(scene, step_us),
-                         std::llround(StreamEvaluator::kHoldPeriods * static_cast<double>(step_us)));
+                         StreamEvaluator::hold_for_period(step_us));
 }
 
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,

@@ -23,8 +23,8 @@
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/simulator_options.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
-#include "evldt/frames/frame_reader.hpp"
 #include "evldt/events/event_validator.hpp"
+#include "evldt/frames/frame_reader.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/sources/event_source.hpp"
 

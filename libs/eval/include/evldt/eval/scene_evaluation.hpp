@@ -3,6 +3,7 @@
 // every ground-truth step is scored (heat-map counts at each tolerance, and the tracking metrics at the
 // first tolerance), whatever the prediction covers, and the lifetime of every predicted id is followed.
 
+#include <cmath>
 #include <functional>
 #include <span>
 #include <vector>
@@ -52,6 +53,10 @@ struct StepCoverage {
 class StreamEvaluator {
  public:
   static constexpr double kHoldPeriods = 1.5;
+  /// The hold for predictions output every `period_us`: kHoldPeriods of it.
+  [[nodiscard]] static Timestamp hold_for_period(Timestamp period_us) {
+    return std::llround(kHoldPeriods * static_cast<double>(period_us));
+  }
   StreamEvaluator(SensorSize sensor, std::vector<double> tolerance_fractions, GroundTruthSteps ground_truth,
                   Timestamp hold_us);
   /// One predicted step; times must not decrease (throws std::invalid_argument), and a step at the

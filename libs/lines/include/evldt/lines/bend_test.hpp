@@ -21,7 +21,6 @@
 #include <vector>
 
 #include "evldt/lines/geometry.hpp"
-#include "evldt/lines/params.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"
 
 namespace evldt {
