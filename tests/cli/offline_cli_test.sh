@@ -151,5 +151,12 @@ set -e
 [[ $status -ne 0 ]] || fail "a missing frame must fail the run"
 grep -q "images.txt:5: frame .*frame_missing.png is missing" "$work/frames_bad.txt" || fail "missing frame: $(cat "$work/frames_bad.txt")"
 grep -q "WARN" "$work/frames_bad.txt" && fail "OpenCV's own warning leaked: $(cat "$work/frames_bad.txt")"
-echo "ok: frames written at 100 Hz, LSD on them F@1% $lsd_f against the exact lines; a missing frame is named"
+printf 'not frames' >"$work/junk.bin"
+set +e
+"$eval" --scene three-lines-fast --duration-s 0.2 --frames-gt "$work/junk.bin" >"$work/frames_junk.txt" 2>&1
+status=$?
+set -e
+[[ $status -eq 1 ]] || fail "--frames-gt of a file that holds no frames must exit 1, got $status"
+grep -q "junk.bin: not a source of frames evldt reads" "$work/frames_junk.txt" || fail "junk frames: $(cat "$work/frames_junk.txt")"
+echo "ok: frames written at 100 Hz, LSD on them F@1% $lsd_f against the exact lines; a missing frame is named, a file of no frames refused"
 echo "offline CLI: 11 passed, 0 failed"

@@ -1,9 +1,13 @@
-// Intensity frames (issue 28): the ECD layout written and read back, its bad inputs, and LSD ground
-// truth from the simulator's frames against the scene's exact lines.
+// Intensity frames (issue 28): the ECD layout written and read back, sensor_msgs/Image in ROS 1
+// bags written with rosbag_storage from the message's description, MVSEC's HDF5 frames written
+// with the HDF5 library, their bad inputs, and LSD ground truth from the simulator's frames against
+// the scene's exact lines.
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <unistd.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -16,6 +20,7 @@
 #include "evldt/frames/frame_writer.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
+#include "support/raw_ros_message.hpp"
 
 namespace evldt {
 namespace {
@@ -91,6 +96,210 @@ TEST_F(FramesTest, BadInputsNameTheFrame) {
   write_list("");
   const auto empty = open_ecd_frames(folder_, kSensor);
   EXPECT_THROW(frame_ground_truth_steps(*empty, LsdParams{}), FrameError);
+}
+
+void put32(std::vector<std::uint8_t>& out, std::uint32_t value) {
+  for (int k = 0; k < 4; ++k) out.push_back(static_cast<std::uint8_t>(value >> (8 * k)));
+}
+void put_string(std::vector<std::uint8_t>& out, const std::string& text) {
+  put32(out, static_cast<std::uint32_t>(text.size()));
+  out.insert(out.end(), text.begin(), text.end());
+}
+
+/// A sensor_msgs/Image as ROS 1 serializes it: header (seq, stamp, frame_id), height, width,
+/// encoding, is_bigendian, step, data; `image` (grey, or BGR for bgr8 and rgb8) in the given pixel
+/// encoding, rows padded by `row_padding` bytes, the data `cut` bytes short.
+RawRosMessage ros_image(Timestamp t_us, const cv::Mat& image, const std::string& encoding, bool big_endian = false, int row_padding = 0,
+                        std::size_t cut = 0) {
+  RawRosMessage message{"sensor_msgs/Image", {}, {}};
+  std::vector<std::uint8_t>& out = message.bytes;
+  put32(out, 1);  // seq
+  put32(out, static_cast<std::uint32_t>(t_us / 1'000'000));
+  put32(out, static_cast<std::uint32_t>(t_us % 1'000'000 * 1000));
+  put_string(out, "davis");
+  put32(out, static_cast<std::uint32_t>(image.rows));
+  put32(out, static_cast<std::uint32_t>(image.cols));
+  put_string(out, encoding);
+  out.push_back(big_endian ? 1 : 0);
+  const int pixel_bytes = encoding == "mono16" ? 2 : encoding == "bgr8" || encoding == "rgb8" ? 3 : 1;
+  const int step = image.cols * pixel_bytes + row_padding;
+  put32(out, static_cast<std::uint32_t>(step));
+  std::vector<std::uint8_t> data;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      if (pixel_bytes == 3) {
+        const cv::Vec3b bgr = image.at<cv::Vec3b>(y, x);
+        for (const int c : encoding == "bgr8" ? std::array{0, 1, 2} : std::array{2, 1, 0}) data.push_back(bgr[c]);
+        continue;
+      }
+      const std::uint8_t grey = image.at<std::uint8_t>(y, x);
+      if (pixel_bytes == 2) {
+        const auto wide = static_cast<std::uint16_t>(grey << 8 | 0xff);  // the low byte is dropped, not rounded into the high one
+        data.push_back(static_cast<std::uint8_t>(big_endian ? wide >> 8 : wide & 0xff));
+        data.push_back(static_cast<std::uint8_t>(big_endian ? wide & 0xff : wide >> 8));
+      } else {
+        data.push_back(grey);
+      }
+    }
+    data.insert(data.end(), static_cast<std::size_t>(row_padding), 0xee);
+  }
+  data.resize(data.size() - cut);
+  put32(out, static_cast<std::uint32_t>(data.size()));
+  out.insert(out.end(), data.begin(), data.end());
+  return message;
+}
+
+class BagFramesTest : public FramesTest {
+ protected:
+  /// A bag of frames on /dvs/image_raw beside a topic of another type.
+  std::filesystem::path write_bag(const std::vector<RawRosMessage>& images) {
+    std::filesystem::create_directories(folder_);
+    const std::filesystem::path path = folder_ / "frames.bag";
+    rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
+    for (std::size_t k = 0; k < images.size(); ++k) {
+      const ros::Time stamp(1.0 + 0.01 * static_cast<double>(k));
+      bag.write("/imu", stamp, RawRosMessage{"sensor_msgs/Imu", std::vector<std::uint8_t>(20, 1), {}});
+      bag.write("/dvs/image_raw", stamp, images[k]);
+    }
+    bag.close();
+    return path;
+  }
+  std::string bag_error(const std::filesystem::path& path, const std::string& topic = {}) {
+    try {
+      const auto reader = open_frames(path, topic, kSensor);
+      while (reader->next()) {
+      }
+    } catch (const FrameError& e) {
+      return e.what();
+    }
+    return "";
+  }
+};
+
+// A red square on blue: bgr8 and rgb8 read in the wrong channel order would weigh them otherwise.
+cv::Mat coloured_square(int left) {
+  cv::Mat image(kSensor.height, kSensor.width, CV_8UC3, cv::Scalar(200, 40, 10));
+  cv::rectangle(image, cv::Rect(left, 12, 24, 24), cv::Scalar(20, 30, 230), cv::FILLED);
+  return image;
+}
+
+TEST_F(BagFramesTest, EveryPixelEncodingReadsAsTheGreyItHolds) {
+  const std::vector<std::string> encodings = {"mono8", "mono16", "mono16", "bgr8", "rgb8"};
+  std::vector<RawRosMessage> images;
+  std::vector<cv::Mat> expected;
+  for (std::size_t k = 0; k < encodings.size(); ++k) {
+    const int left = 4 + 6 * static_cast<int>(k);
+    const bool colour = encodings[k] != "mono8" && encodings[k] != "mono16";
+    images.push_back(ros_image(1'700'000'000'000'000 + 10'000 * static_cast<Timestamp>(k), colour ? coloured_square(left) : square(left),
+                               encodings[k], k == 2, k == 3 ? 5 : 0));
+    expected.push_back(square(left));
+    if (colour) cv::cvtColor(coloured_square(left), expected.back(), cv::COLOR_BGR2GRAY);
+  }
+  const std::filesystem::path bag = write_bag(images);
+  for (const std::string topic : {"", "/dvs/image_raw"}) {
+    const auto reader = open_frames(bag, topic, kSensor);
+    for (std::size_t k = 0; k < encodings.size(); ++k) {
+      const auto frame = reader->next();
+      ASSERT_TRUE(frame) << encodings[k];
+      EXPECT_EQ(frame->t_us, 1'700'000'000'000'000 + 10'000 * static_cast<Timestamp>(k));
+      ASSERT_EQ(frame->image.type(), CV_8UC1);
+      EXPECT_EQ(cv::norm(frame->image, expected[k], cv::NORM_INF), 0.0) << encodings[k] << ", " << frame->name;
+    }
+    EXPECT_FALSE(reader->next());
+  }
+}
+
+TEST_F(BagFramesTest, BadInputsNameTheFrame) {
+  const Timestamp t0 = 1'700'000'000'000'000;
+  const auto nth = [](const std::string& error) { return error.find("message 1 of /dvs/image_raw") != std::string::npos; };
+  std::string error = bag_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "bayer_rggb8")}));
+  EXPECT_TRUE(nth(error) && error.find("pixel encoding 'bayer_rggb8'") != std::string::npos) << error;
+  error = bag_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)), "mono8")}));
+  EXPECT_TRUE(nth(error) && error.find("frame is 10x10, the sensor 64x48") != std::string::npos) << error;
+  error = bag_error(write_bag({ros_image(t0 + 10, square(8), "mono8"), ros_image(t0, square(8), "mono8")}));
+  EXPECT_TRUE(nth(error) && error.find("earlier than the one before") != std::string::npos) << error;
+  error = bag_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "mono16", false, 0, 7)}));
+  EXPECT_TRUE(nth(error) && error.find("holds only") != std::string::npos) << error;
+  const std::filesystem::path good = write_bag({ros_image(t0, square(8), "mono8")});
+  error = bag_error(good, "/imu");
+  EXPECT_NE(error.find("topic /imu is of type sensor_msgs/Imu, not sensor_msgs/Image"), std::string::npos) << error;
+  error = bag_error(good, "/none");
+  EXPECT_NE(error.find("no topic /none (topics: "), std::string::npos) << error;
+  std::ofstream(folder_ / "junk.bin") << "not frames";
+  error = bag_error(folder_ / "junk.bin");
+  EXPECT_NE(error.find("not a source of frames"), std::string::npos) << error;
+  // Nothing is scored from a bag whose frames throw.
+  const auto reader = open_frames(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "yuv422")}), "", kSensor);
+  EXPECT_THROW(frame_ground_truth_steps(*reader, LsdParams{}), FrameError);
+}
+
+/// An HDF5 file in MVSEC's layout: `frames` (8-bit grey, all one size) as N x H x W at `dataset`,
+/// their times in seconds at dataset + "_ts" (`times` may differ in count, to make a bad file).
+void write_mvsec_frames(const std::filesystem::path& path, const std::vector<cv::Mat>& frames, const std::vector<double>& times,
+                        const std::string& dataset = "/davis/left/image_raw", hid_t pixel_type = H5T_NATIVE_UINT8) {
+  const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t links = H5Pcreate(H5P_LINK_CREATE);
+  H5Pset_create_intermediate_group(links, 1);
+  const hsize_t dims[3] = {frames.size(), static_cast<hsize_t>(frames.front().rows), static_cast<hsize_t>(frames.front().cols)};
+  const hid_t space = H5Screate_simple(3, dims, nullptr);
+  const hid_t images = H5Dcreate2(file, dataset.c_str(), pixel_type, space, links, H5P_DEFAULT, H5P_DEFAULT);
+  std::vector<std::uint8_t> pixels;
+  for (const cv::Mat& frame : frames) pixels.insert(pixels.end(), frame.datastart, frame.dataend);
+  if (pixel_type == H5T_NATIVE_UINT8) H5Dwrite(images, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, pixels.data());
+  const hsize_t count = times.size();
+  const hid_t time_space = H5Screate_simple(1, &count, nullptr);
+  const hid_t stamps = H5Dcreate2(file, (dataset + "_ts").c_str(), H5T_NATIVE_DOUBLE, time_space, links, H5P_DEFAULT, H5P_DEFAULT);
+  H5Dwrite(stamps, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, times.data());
+  for (const hid_t id : {stamps, time_space, images, space, links}) H5Idec_ref(id);
+  H5Fclose(file);
+}
+
+TEST_F(FramesTest, MvsecHdf5FramesOfEitherCameraReadWithTheirTimes) {
+  std::filesystem::create_directories(folder_);
+  const std::filesystem::path path = folder_ / "indoor_flying1_data.hdf5";
+  write_mvsec_frames(path, {square(4), square(10), square(16)}, {1504645177.42, 1504645177.45, 1504645177.48});
+  const auto reader = open_frames(path, "", kSensor);
+  for (int k = 0; k < 3; ++k) {
+    const auto frame = reader->next();
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->t_us, 1'504'645'177'420'000 + 30'000 * k);
+    EXPECT_EQ(cv::norm(frame->image, square(4 + 6 * k), cv::NORM_INF), 0.0) << frame->name;
+    EXPECT_NE(frame->name.find("/davis/left/image_raw[" + std::to_string(k) + "]"), std::string::npos) << frame->name;
+  }
+  EXPECT_FALSE(reader->next());
+  const std::filesystem::path right_camera = folder_ / "right.hdf5";
+  write_mvsec_frames(right_camera, {square(20)}, {2.5}, "/davis/right/image_raw");
+  const auto right = open_frames(right_camera, "/davis/right/image_raw", kSensor)->next();
+  ASSERT_TRUE(right);
+  EXPECT_EQ(right->t_us, 2'500'000);
+  EXPECT_EQ(cv::norm(right->image, square(20), cv::NORM_INF), 0.0);
+}
+
+TEST_F(FramesTest, MvsecHdf5BadInputsAreClearErrors) {
+  std::filesystem::create_directories(folder_);
+  const std::filesystem::path path = folder_ / "bad.hdf5";
+  const auto error = [&](const std::string& stream = {}) {
+    try {
+      const auto reader = open_frames(path, stream, kSensor);
+      while (reader->next()) {
+      }
+    } catch (const FrameError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  write_mvsec_frames(path, {square(4), square(8)}, {1.0});
+  EXPECT_NE(error().find("/davis/left/image_raw_ts holds 1 times for 2 frames"), std::string::npos) << error();
+  write_mvsec_frames(path, {square(4)}, {1.0});
+  EXPECT_NE(error("/davis/right/image_raw").find("no frames /davis/right/image_raw"), std::string::npos) << error("/davis/right/image_raw");
+  write_mvsec_frames(path, {square(4), square(8)}, {1.0, 0.5});
+  EXPECT_NE(error().find("image_raw[1]: frame at 500000 us is earlier than the one before"), std::string::npos) << error();
+  write_mvsec_frames(path, {cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))}, {1.0});
+  EXPECT_NE(error().find("frame is 10x10, the sensor 64x48"), std::string::npos) << error();
+  write_mvsec_frames(path, {square(4)}, {1.0}, "/davis/left/image_raw", H5T_NATIVE_UINT16);
+  EXPECT_NE(error().find("is not N x H x W frames of 8-bit pixels"), std::string::npos) << error();
+  write_mvsec_frames(path, {square(4)}, {std::nan("")});
+  EXPECT_NE(error().find("image_raw[0]: its time"), std::string::npos) << error();
 }
 
 TEST_F(FramesTest, LsdFindsTheSidesOfASquare) {

@@ -31,6 +31,7 @@ struct Options {
   std::filesystem::path segments, whole_lines, ground_truth, frames_gt, write_gt, json, pr_png, lifetime_png, tracks_png;
   LsdParams lsd;
   std::string lcm_channel;
+  std::string frames_topic;  ///< of a bag or HDF5 file given to --frames-gt
   std::vector<double> tolerances{0.01, 0.02};
   std::vector<float> pr_thresholds;
   Timestamp step_us = 10000;
@@ -115,7 +116,7 @@ void write_ground_truth(const GroundTruthSteps& truth, const std::filesystem::pa
 GroundTruthSteps ground_truth_steps(const Options& options, const SimulatorOptions& sim, SensorSize sensor) {
   GroundTruthSteps truth;
   if (!options.frames_gt.empty()) {
-    const auto frames = open_ecd_frames(options.frames_gt, sensor);
+    const auto frames = open_frames(options.frames_gt, options.frames_topic, sensor);
     truth = frame_ground_truth_steps(*frames, options.lsd);
     spdlog::info("ground truth: LSD on {} frames of {} (segments of {} px or more)", truth.times.size(), options.frames_gt.string(),
                  options.lsd.min_length_px);
@@ -323,7 +324,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   }
   if (!options.segments.empty()) {
     if (options.frames_gt.empty() && options.ground_truth.empty() == !sim.scene_selected()) {
-      spdlog::error("with --segments give the ground truth: --ground-truth FILE, --scene NAME or --frames-gt FOLDER");
+      spdlog::error("with --segments give the ground truth: --ground-truth FILE, --scene NAME or --frames-gt SOURCE");
       return 1;
     }
     const auto sensor = sim.scene_selected() ? std::optional<SensorSize>(sim.scene().sensor) : pipeline_options.sensor();
@@ -428,8 +429,12 @@ int main(int argc, char** argv) {
   app.add_option("--ground-truth", options.ground_truth, "Ground-truth CSV (from evldt-sim)")->check(CLI::ExistingFile);
   app.add_option("--frames-gt", options.frames_gt,
                  "Ground truth as the paper makes it: LSD on the intensity frames of this ECD folder (images.txt and "
-                 "images/; evldt-sim --frames-hz writes one), in place of the exact lines")
+                 "images/; evldt-sim --frames-hz writes one), ROS 1 bag (sensor_msgs/Image: mono8, mono16, bgr8, rgb8) or "
+                 "MVSEC HDF5 file, in place of the exact lines")
       ->check(CLI::ExistingPath);
+  app.add_option("--frames-topic", options.frames_topic,
+                 "With --frames-gt a bag: its image topic (default: the first sensor_msgs/Image); an HDF5 file: its frame "
+                 "dataset (default: /davis/left/image_raw)");
   app.add_option("--write-gt", options.write_gt,
                  "Write the ground truth scored against (LSD's lines with --frames-gt) as a CSV like evldt-sim's "
                  "(t_us,gt_id,x0,y0,x1,y1), for --ground-truth of other runs");

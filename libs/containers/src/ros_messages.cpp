@@ -236,4 +236,25 @@ void fill_packet(const RosEventMessage& message, RecordingPacket& packet) {
   packet.sensor = sensor_of(message.width, message.height);
 }
 
+RecordingImage decode_ros_image(RosSerialization serialization, std::span<const std::uint8_t> bytes) {
+  MessageReader reader(serialization, bytes);
+  RecordingImage image;
+  if (serialization == RosSerialization::Ros1) reader.read<std::uint32_t>();  // header.seq (ROS 1 only)
+  const auto sec = reader.read<std::uint32_t>();
+  const auto nsec = reader.read<std::uint32_t>();
+  image.t_us = Timestamp{sec} * 1'000'000 + nsec / 1000;
+  reader.read_string();  // header.frame_id
+  image.height = reader.read<std::uint32_t>();
+  image.width = reader.read<std::uint32_t>();
+  image.encoding = reader.read_string();
+  image.big_endian = reader.read<std::uint8_t>() != 0;
+  image.step = reader.read<std::uint32_t>();
+  image.data = reader.read_bytes();
+  if (std::uint64_t{image.step} * image.height > image.data.size()) {
+    throw std::runtime_error("an image of " + std::to_string(image.height) + " rows of " + std::to_string(image.step) + " bytes holds only " +
+                             std::to_string(image.data.size()) + " bytes");
+  }
+  return image;
+}
+
 }  // namespace evldt

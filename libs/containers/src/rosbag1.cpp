@@ -87,7 +87,70 @@ class Rosbag1Source final : public PacketSource {
   std::vector<std::uint8_t> buffer_, scratch_;
 };
 
+class Rosbag1ImageSource final : public ImageSource {
+ public:
+  Rosbag1ImageSource(const std::filesystem::path& path, const std::string& topic) : path_(path.string()) {
+    try {
+      bag_.open(path_, rosbag::bagmode::Read);
+      rosbag::View all(bag_);
+      std::string listing;
+      for (const rosbag::ConnectionInfo* connection : all.getConnections()) {
+        listing += (listing.empty() ? "" : ", ") + connection->topic + " (" + connection->datatype + ")";
+        if (!topic_.empty() || (topic.empty() ? connection->datatype != kRos1ImageType : connection->topic != topic)) continue;
+        if (connection->datatype != kRos1ImageType) {
+          throw std::runtime_error("topic " + topic + " is of type " + connection->datatype + ", not " + std::string(kRos1ImageType));
+        }
+        topic_ = connection->topic;
+      }
+      if (topic_.empty()) {
+        throw std::runtime_error((topic.empty() ? "no topic of type " + std::string(kRos1ImageType) : "no topic " + topic) +
+                                 " (topics: " + (listing.empty() ? "none" : listing) + ")");
+      }
+      view_.emplace(bag_, rosbag::TopicQuery(topic_));
+      next_ = view_->begin();
+    } catch (const rosbag::BagException& error) {
+      throw std::runtime_error("'" + path_ + "' is not a readable ROS 1 bag: " + error.what());
+    } catch (const std::runtime_error& error) {
+      throw std::runtime_error("'" + path_ + "': " + error.what());
+    }
+  }
+
+  bool next(RecordingImage& image, std::string& location) override {
+    location = path_ + ", message " + std::to_string(read_) + " of " + topic_;
+    try {
+      if (next_ == view_->end()) return false;
+      const rosbag::MessageInstance& message = *next_;
+      buffer_.resize(message.size());
+      ros::serialization::OStream stream(buffer_.data(), static_cast<std::uint32_t>(buffer_.size()));
+      message.write(stream);
+      image = decode_ros_image(RosSerialization::Ros1, buffer_);
+      ++read_;
+      ++next_;
+      return true;
+    } catch (const rosbag::BagException& error) {
+      throw std::runtime_error(location + ": " + error.what());
+    } catch (const std::runtime_error& error) {
+      throw std::runtime_error(location + ": " + error.what());
+    }
+  }
+
+  [[nodiscard]] std::string description() const override { return "ROS 1 bag, " + topic_ + " (" + std::string(kRos1ImageType) + ")"; }
+
+ private:
+  std::string path_;
+  rosbag::Bag bag_;
+  std::string topic_;
+  std::optional<rosbag::View> view_;
+  rosbag::View::iterator next_;
+  std::uint64_t read_ = 0;
+  std::vector<std::uint8_t> buffer_;  // the message the image's data points into
+};
+
 }  // namespace
+
+std::unique_ptr<ImageSource> open_rosbag1_images(const std::filesystem::path& path, const std::string& topic) {
+  return std::make_unique<Rosbag1ImageSource>(path, topic);
+}
 
 std::unique_ptr<PacketSource> open_rosbag1(const std::filesystem::path& path, const std::string& topic) {
   return std::make_unique<Rosbag1Source>(path, topic);

@@ -140,12 +140,15 @@ def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), out
                            int(output_period_us))
 
 
-def read_frames(path, width, height):
+def read_frames(path, width, height, topic=""):
     """The intensity frames of a folder in the Event Camera Dataset's layout (images.txt and images/;
-    evldt-sim --frames-hz writes one): a list of (t_us, image), image a height x width uint8 array,
-    in time order. A frame that is missing, unreadable, of another size or out of time order raises
+    evldt-sim --frames-hz writes one), of a ROS 1 bag's sensor_msgs/Image topic (mono8, mono16, bgr8
+    or rgb8, read as grey) or of an HDF5 file in MVSEC's layout (/davis/left/image_raw and its _ts
+    times); ``topic`` picks the bag's topic or the HDF5 dataset (empty: the first / the left camera).
+    A list of (t_us, image), image a height x width uint8 array, in time order. A frame that is
+    missing, unreadable, of another size, of another pixel encoding or out of time order raises
     FrameError (a ValueError) naming it."""
-    return _evldt.read_frames(str(path), int(width), int(height))
+    return _evldt.read_frames(str(path), int(width), int(height), str(topic))
 
 
 def simulate(scene, gt_period_us=10_000, **options):

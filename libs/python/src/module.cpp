@@ -333,9 +333,9 @@ py::tuple simulate(const std::vector<std::string>& flags, Timestamp gt_period_us
   return py::make_tuple(events_to_numpy(events), to_numpy(truth), scene.sensor.width, scene.sensor.height);
 }
 
-// The frames of an ECD folder as (t_us, HxW uint8 array) pairs; FrameError names a bad frame.
-py::list read_frames(const std::string& path, int width, int height) {
-  const auto reader = open_ecd_frames(path, SensorSize{width, height});
+// The frames of an ECD folder or a bag as (t_us, HxW uint8 array) pairs; FrameError names a bad frame.
+py::list read_frames(const std::string& path, int width, int height, const std::string& topic) {
+  const auto reader = open_frames(path, topic, SensorSize{width, height});
   py::list frames;
   while (auto frame = reader->next()) {
     py::array_t<std::uint8_t> image({frame->image.rows, frame->image.cols});
@@ -383,5 +383,5 @@ PYBIND11_MODULE(_evldt, m) {
   m.def("evaluate", &evaluate, py::arg("segments"), py::arg("ground_truth"), py::arg("width"), py::arg("height"),
         py::arg("tolerances"), py::arg("output_period_us"));
   m.def("simulate", &simulate, py::arg("flags"), py::arg("gt_period_us"));
-  m.def("read_frames", &read_frames, py::arg("path"), py::arg("width"), py::arg("height"));
+  m.def("read_frames", &read_frames, py::arg("path"), py::arg("width"), py::arg("height"), py::arg("topic") = "");
 }

@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "evldt/containers/image_source.hpp"
 #include "evldt/containers/packet_source.hpp"
 
 namespace evldt {
@@ -75,5 +76,13 @@ inline constexpr std::string_view kKnownEventTypes =
 
 /// The message's events, encoding, time base and sensor size into `packet`.
 void fill_packet(const RosEventMessage& message, RecordingPacket& packet);
+
+inline constexpr std::string_view kRos1ImageType = "sensor_msgs/Image";
+
+/// Decodes a sensor_msgs/Image (a DAVIS's APS frame in the Event Camera Dataset's and MVSEC's
+/// bags): header, height, width, encoding, is_bigendian, step, data; header.stamp on the clock of
+/// the events (dvs_events: sec * 10^6 + nsec / 1000 us). Throws std::runtime_error with the reason
+/// (and offset) when the bytes are not such a message or hold fewer than step * height bytes of data.
+RecordingImage decode_ros_image(RosSerialization serialization, std::span<const std::uint8_t> bytes);
 
 }  // namespace evldt

@@ -19,4 +19,10 @@ inline constexpr std::string_view kRosbag1Magic = "#ROSBAG V2.0\n";
 /// std::runtime_error naming the file if it is no readable bag or has no such topic (listing them).
 std::unique_ptr<PacketSource> open_rosbag1(const std::filesystem::path& path, const std::string& topic);
 
+class ImageSource;
+/// The sensor_msgs/Image messages of a ROS 1 bag's topic (empty: the first topic of that type), in
+/// time order. Throws std::runtime_error naming the file if it is no readable bag or has no such
+/// topic (listing them).
+std::unique_ptr<ImageSource> open_rosbag1_images(const std::filesystem::path& path, const std::string& topic);
+
 }  // namespace evldt

@@ -1,0 +1,36 @@
+#pragma once
+// Intensity images that containers hold beside events (a DAVIS's APS frames), kept apart from their
+// pixel encodings as events are from theirs: a container yields images with their encoding's name,
+// and libs/frames turns each into a grey frame.
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "evldt/events/event.hpp"
+
+namespace evldt {
+
+/// One image as a container stores it.
+struct RecordingImage {
+  Timestamp t_us = 0;  ///< on the clock of the container's events
+  std::uint32_t width = 0, height = 0;
+  std::string encoding;  ///< ROS's names: "mono8", "mono16", "bgr8", "rgb8"...
+  bool big_endian = false;
+  std::uint32_t step = 0;  ///< bytes per row
+  std::span<const std::uint8_t> data;  ///< at least step * height bytes, valid until the next image
+};
+
+/// The images of one stream of a container, in the container's order.
+class ImageSource {
+ public:
+  virtual ~ImageSource() = default;
+  /// The next image; false at the end. `location` is set to which one it is (file, message or
+  /// index), for errors. Throws std::runtime_error naming the file and image for one that cannot
+  /// be read.
+  virtual bool next(RecordingImage& image, std::string& location) = 0;
+  /// "ROS 1 bag, /dvs/image_raw (sensor_msgs/Image)".
+  [[nodiscard]] virtual std::string description() const = 0;
+};
+
+}  // namespace evldt
