@@ -1,5 +1,6 @@
 // Intensity frames (issue 28): the ECD layout written and read back, sensor_msgs/Image in ROS 1
-// bags written with rosbag_storage from the message's description, MVSEC's HDF5 frames written
+// bags written with rosbag_storage and in ROS 2 bags (CDR in SQLite) written from the message's
+// description, MVSEC's HDF5 frames written
 // with the HDF5 library, their bad inputs, and LSD ground truth from the simulator's frames against
 // the scene's exact lines.
 
@@ -21,6 +22,7 @@
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
 #include "support/raw_ros_message.hpp"
+#include "support/ros2_bag_writer.hpp"
 
 namespace evldt {
 namespace {
@@ -231,6 +233,54 @@ TEST_F(BagFramesTest, BadInputsNameTheFrame) {
   // Nothing is scored from a bag whose frames throw.
   const auto reader = open_frames(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "yuv422")}), "", kSensor);
   EXPECT_THROW(frame_ground_truth_steps(*reader, LsdParams{}), FrameError);
+}
+
+/// A sensor_msgs/msg/Image in CDR of either byte order (a mono8 frame).
+std::vector<std::uint8_t> ros2_image(Timestamp t_us, const cv::Mat& image, bool little_endian) {
+  test_support::CdrWriter cdr(little_endian);
+  cdr.put<std::int32_t>(static_cast<std::int32_t>(t_us / 1'000'000));
+  cdr.put<std::uint32_t>(static_cast<std::uint32_t>(t_us % 1'000'000 * 1000));
+  cdr.put_string("davis");
+  cdr.put<std::uint32_t>(static_cast<std::uint32_t>(image.rows));
+  cdr.put<std::uint32_t>(static_cast<std::uint32_t>(image.cols));
+  cdr.put_string("mono8");
+  cdr.put<std::uint8_t>(0);
+  cdr.put<std::uint32_t>(static_cast<std::uint32_t>(image.cols));
+  cdr.put_bytes(std::vector<std::uint8_t>(image.datastart, image.dataend));
+  return cdr.bytes();
+}
+
+TEST_F(FramesTest, Ros2BagFramesInCdrOfEitherByteOrder) {
+  std::filesystem::create_directories(folder_);
+  const std::filesystem::path path = folder_ / "frames.db3";
+  {
+    test_support::BagWriter bag(path);
+    bag.topic(1, "/events", "event_camera_msgs/msg/EventPacket");
+    bag.topic(2, "/dvs/image_raw", "sensor_msgs/msg/Image");
+    for (int k = 0; k < 4; ++k) bag.message(2, 1'000'000'000 + k, ros2_image(1'700'000'000'000'000 + 10'000 * k, square(4 + 6 * k), k % 2 == 0));
+    bag.message(2, 1'000'000'100, {0, 1, 0, 0, 1});  // a message cut short
+  }
+  const auto reader = open_frames(path, "", kSensor);
+  for (int k = 0; k < 4; ++k) {
+    const auto frame = reader->next();
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->t_us, 1'700'000'000'000'000 + 10'000 * k);
+    EXPECT_EQ(cv::norm(frame->image, square(4 + 6 * k), cv::NORM_INF), 0.0) << frame->name;
+  }
+  try {
+    reader->next();
+    ADD_FAILURE() << "a cut message must be an error";
+  } catch (const FrameError& e) {
+    EXPECT_NE(std::string(e.what()).find("message id 5 of /dvs/image_raw: CDR byte 4: message ends early"), std::string::npos) << e.what();
+  }
+  try {
+    open_frames(path, "/events", kSensor);
+    ADD_FAILURE() << "an event topic holds no frames";
+  } catch (const FrameError& e) {
+    EXPECT_NE(std::string(e.what()).find("topic /events is of type event_camera_msgs/msg/EventPacket, not sensor_msgs/msg/Image"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 /// An HDF5 file in MVSEC's layout: `frames` (8-bit grey, all one size) as N x H x W at `dataset`,

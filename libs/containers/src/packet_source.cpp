@@ -96,7 +96,7 @@ std::unique_ptr<PacketSource> open_packet_container(const std::filesystem::path&
   std::array<char, 16> magic{};
   file.read(magic.data(), magic.size());
   const std::string_view start(magic.data(), static_cast<std::size_t>(file.gcount()));
-  if (start.starts_with(std::string_view("SQLite format 3\0", 16))) return open_rosbag2(path, topic);
+  if (start.starts_with(kSqliteMagic)) return open_rosbag2(path, topic);
   if (start.starts_with(kAedat4Magic)) return open_aedat4(path);
   if (start.starts_with(kRosbag1Magic)) return open_rosbag1(path, topic);
   if (start.starts_with(kMcapMagic)) return open_mcap(path, topic);

@@ -1,14 +1,10 @@
-// Frames from containers that hold images beside events (ROS 1 bags, MVSEC's HDF5): each image,
+// Frames from containers that hold images beside events (ROS 1 and 2 bags, MVSEC's HDF5): each image,
 // through the conversion its pixel encoding names, to the 8-bit grey frame LSD runs on.
 
-#include <algorithm>
-#include <fstream>
 
 #include <opencv2/imgproc.hpp>
 
-#include "evldt/containers/hdf5_events.hpp"
-#include "evldt/containers/hdf5_images.hpp"
-#include "evldt/containers/rosbag1.hpp"
+#include "evldt/containers/image_source.hpp"
 #include "evldt/frames/frame_reader.hpp"
 
 namespace evldt {
@@ -86,27 +82,20 @@ class ImageFrameReader final : public FrameReader {
   Timestamp last_us_ = 0;
 };
 
-/// A container's images as frames; its errors as FrameError.
-template <typename Open>
-std::unique_ptr<FrameReader> open_container_frames(Open&& open, SensorSize sensor) {
-  try {
-    return std::make_unique<ImageFrameReader>(open(), sensor);
-  } catch (const std::runtime_error& error) {
-    throw FrameError(error.what());
-  }
-}
-
 }  // namespace
 
 std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream, SensorSize sensor) {
   if (std::filesystem::is_directory(path) || path.filename() == "images.txt") return open_ecd_frames(path, sensor);
-  std::string start(std::max(kRosbag1Magic.size(), kHdf5Magic.size()), '\0');
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FrameError(path.string() + ": cannot be opened");
-  in.read(start.data(), static_cast<std::streamsize>(start.size()));
-  if (start.starts_with(kRosbag1Magic)) return open_container_frames([&] { return open_rosbag1_images(path, stream); }, sensor);
-  if (start.starts_with(kHdf5Magic)) return open_container_frames([&] { return open_hdf5_images(path, stream); }, sensor);
-  throw FrameError(path.string() + ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 bag or MVSEC's HDF5)");
+  std::unique_ptr<ImageSource> images;
+  try {
+    images = open_image_container(path, stream);
+  } catch (const std::runtime_error& error) {
+    throw FrameError(error.what());
+  }
+  if (!images) {
+    throw FrameError(path.string() + ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 or 2 bag, MVSEC's HDF5)");
+  }
+  return std::make_unique<ImageFrameReader>(std::move(images), sensor);
 }
 
 }  // namespace evldt

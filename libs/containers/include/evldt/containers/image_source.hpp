@@ -4,6 +4,8 @@
 // and libs/frames turns each into a grey frame.
 
 #include <cstdint>
+#include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 
@@ -32,5 +34,11 @@ class ImageSource {
   /// "ROS 1 bag, /dvs/image_raw (sensor_msgs/Image)".
   [[nodiscard]] virtual std::string description() const = 0;
 };
+
+/// The images of the container `path` holds, recognised by its first bytes: a ROS 1 or ROS 2 bag's
+/// image topic `stream` (empty: the first), an HDF5 file's frames `stream` (empty: MVSEC's
+/// /davis/left/image_raw); nullptr for a file that is none of them. Throws std::runtime_error naming
+/// the file for a container without such images.
+std::unique_ptr<ImageSource> open_image_container(const std::filesystem::path& path, const std::string& stream);
 
 }  // namespace evldt

@@ -78,6 +78,7 @@ inline constexpr std::string_view kKnownEventTypes =
 void fill_packet(const RosEventMessage& message, RecordingPacket& packet);
 
 inline constexpr std::string_view kRos1ImageType = "sensor_msgs/Image";
+inline constexpr std::string_view kRos2ImageType = "sensor_msgs/msg/Image";
 
 /// Decodes a sensor_msgs/Image (a DAVIS's APS frame in the Event Camera Dataset's and MVSEC's
 /// bags): header, height, width, encoding, is_bigendian, step, data; header.stamp on the clock of
