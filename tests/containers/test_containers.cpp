@@ -20,6 +20,7 @@
 #include "aedat4_header_generated.h"
 #include "dv_events_generated.h"
 #include "evldt/containers/aedat4.hpp"
+#include "evldt/containers/image_source.hpp"
 #include "evldt/containers/mcap.hpp"
 #include "evldt/containers/packet_source.hpp"
 #include "evldt/containers/rosbag1.hpp"
@@ -799,6 +800,65 @@ TEST(Mcap, Ros1EventArraysAndTopicChoice) {
   EXPECT_EQ(left.sensor, (SensorSize{240, 180}));
   const ReadAll right = read_all(path, "/dvs_right/events");
   EXPECT_EQ(right.events, events_of(second));
+}
+
+/// A sensor_msgs/msg/Image in CDR: a 4 x 2 mono8 frame whose pixels count up from `first`.
+std::vector<std::uint8_t> image_cdr(std::int32_t sec, std::uint32_t nanosec, std::uint8_t first) {
+  CdrWriter cdr(true);
+  cdr.put<std::int32_t>(sec);
+  cdr.put<std::uint32_t>(nanosec);
+  cdr.put_string("davis");
+  cdr.put<std::uint32_t>(2);  // height
+  cdr.put<std::uint32_t>(4);  // width
+  cdr.put_string("mono8");
+  cdr.put<std::uint8_t>(0);
+  cdr.put<std::uint32_t>(4);  // step
+  std::vector<std::uint8_t> pixels(8);
+  for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<std::uint8_t>(first + i);
+  cdr.put_bytes(pixels);
+  return cdr.bytes();
+}
+
+TEST(Mcap, ImagesOfAChannelBesideTheEvents) {
+  TempDir dir;
+  const auto path = dir.file("frames.mcap");
+  McapWriter mcap("lz4");
+  mcap.schema(1, std::string(kRos2EventPacketType));
+  mcap.schema(2, "sensor_msgs/msg/Image");
+  mcap.channel(1, 1, "/events");
+  mcap.channel(2, 2, "/dvs/image_raw");
+  PacketFields fields;
+  fields.events = {1, 2, 3};
+  for (std::uint8_t k = 0; k < 3; ++k) {
+    mcap.message(1, k, event_packet_cdr(fields));
+    mcap.message(2, k, image_cdr(1700000000, 250'000'000u * k, static_cast<std::uint8_t>(10 * k)));
+  }
+  mcap.finish(path);
+  const auto images = open_image_container(path, "");
+  ASSERT_TRUE(images);
+  EXPECT_EQ(images->description(), "MCAP, /dvs/image_raw (sensor_msgs/msg/Image)");
+  RecordingImage image;
+  std::string location;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(images->next(image, location));
+    EXPECT_EQ(image.t_us, 1'700'000'000'000'000 + 250'000 * k);
+    EXPECT_EQ(image.width, 4u);
+    EXPECT_EQ(image.height, 2u);
+    EXPECT_EQ(image.encoding, "mono8");
+    EXPECT_EQ(image.step, 4u);
+    ASSERT_EQ(image.data.size(), 8u);
+    EXPECT_EQ(image.data[7], 10 * k + 7) << location;
+    EXPECT_NE(location.find("message " + std::to_string(k) + " of /dvs/image_raw"), std::string::npos) << location;
+  }
+  EXPECT_FALSE(images->next(image, location));
+  try {
+    open_mcap_images(path, "/events");
+    ADD_FAILURE() << "an event channel holds no images";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("channel /events is of type event_camera_msgs/msg/EventPacket (cdr), not sensor_msgs/msg/Image"),
+              std::string::npos)
+        << error.what();
+  }
 }
 
 TEST(Mcap, CorruptCutOrUnclosedFilesGiveTheEventsBeforeThenAnError) {

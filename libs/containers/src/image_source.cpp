@@ -6,6 +6,7 @@
 
 #include "evldt/containers/hdf5_events.hpp"
 #include "evldt/containers/hdf5_images.hpp"
+#include "evldt/containers/mcap.hpp"
 #include "evldt/containers/rosbag1.hpp"
 #include "evldt/containers/rosbag2.hpp"
 
@@ -20,6 +21,7 @@ std::unique_ptr<ImageSource> open_image_container(const std::filesystem::path& p
   if (start.starts_with(kRosbag1Magic)) return open_rosbag1_images(path, stream);
   if (start.starts_with(kSqliteMagic)) return open_rosbag2_images(path, stream);
   if (start.starts_with(kHdf5Magic)) return open_hdf5_images(path, stream);
+  if (start.starts_with(kMcapMagic)) return open_mcap_images(path, stream);
   return nullptr;
 }
 

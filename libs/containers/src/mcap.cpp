@@ -2,6 +2,7 @@
 
 #include <zlib.h>
 
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <vector>
@@ -63,10 +64,16 @@ struct Schema {
   std::string definition;
 };
 
-class McapSource final : public PacketSource {
+/// One channel of an MCAP file, its messages read in file order: the channel `wanted`, or if empty
+/// the first that `accepts` (given its type, message encoding and schema definition). For errors,
+/// `kind` names what it looks for ("an event type") and `expected` the types it accepts. Throws
+/// std::runtime_error naming the file for a file it cannot read or no such channel.
+class McapChannel {
  public:
-  McapSource(const std::filesystem::path& path, const std::string& topic)
-      : file_(path, "MCAP"), path_(file_.path()), wanted_(topic) {
+  using Accepts = std::function<bool(const std::string& type, const std::string& encoding, const std::string& definition)>;
+  McapChannel(const std::filesystem::path& path, const std::string& topic, Accepts accepts, std::string kind, std::string expected)
+      : file_(path, "MCAP"), path_(file_.path()), wanted_(topic), accepts_(std::move(accepts)), kind_(std::move(kind)),
+        expected_(std::move(expected)) {
     std::string magic(kMcapMagic.size(), '\0');
     file_.read_exactly(magic.data(), magic.size(), "the magic");
     if (magic != kMcapMagic) throw FormatError(path_, 0, "not an MCAP file");
@@ -78,24 +85,25 @@ class McapSource final : public PacketSource {
       for (const auto& entry : channels_) {
         listing += (listing.empty() ? "" : ", ") + entry.second.topic + " (" + entry.second.type + ", " + entry.second.encoding + ")";
       }
-      throw std::runtime_error("'" + path_ + "': " + (wanted_.empty() ? std::string("no channel of an event type") : "no channel " + wanted_) +
+      throw std::runtime_error("'" + path_ + "': " + (wanted_.empty() ? "no channel of " + kind_ : "no channel " + wanted_) +
                                " (channels: " + (listing.empty() ? "none" : listing) + ")");
     }
   }
 
-  bool next(RecordingPacket& packet) override {
+  /// The next message's payload (valid until the next call) and where it is; false at the end.
+  /// Throws FormatError for a file that cannot be read on.
+  bool next(std::span<const std::uint8_t>& message, std::string& location, std::uint64_t& offset) {
     Record record;
     while (next_record(record)) {
       if (!handle(record)) continue;
-      packet.location = "message " + std::to_string(read_) + " of " + topic_ + " (record at byte " + std::to_string(record.offset) + ")";
+      location = "message " + std::to_string(read_) + " of " + topic_ + " (record at byte " + std::to_string(record.offset) + ")";
+      offset = record.offset;
       try {
         FieldReader fields(record.content);
         fields.take(2 + 4 + 8 + 8);  // channel id, sequence, log time, publish time
-        const RosEventMessage message = layout_->decode(fields.rest(), scratch_);
-        fill_packet(message, packet);
-        if (camera_.empty()) camera_ = message.frame_id;
+        message = fields.rest();
       } catch (const std::runtime_error& error) {
-        throw FormatError(path_, record.offset, packet.location + ": " + error.what());
+        throw FormatError(path_, record.offset, location + ": " + error.what());
       }
       ++read_;
       return true;
@@ -103,13 +111,15 @@ class McapSource final : public PacketSource {
     return false;
   }
 
-  [[nodiscard]] std::optional<SensorSize> geometry() const override { return std::nullopt; }  // in the messages
-  [[nodiscard]] std::string camera() const override { return camera_; }
-  [[nodiscard]] std::string description() const override { return "MCAP, " + topic_ + " (" + type_ + ")"; }
-  [[nodiscard]] double progress() const override {
+  [[nodiscard]] const std::string& path() const { return path_; }
+  [[nodiscard]] const std::string& topic() const { return topic_; }
+  [[nodiscard]] const std::string& type() const { return type_; }
+  [[nodiscard]] const std::string& definition() const { return definition_; }
+  [[nodiscard]] RosSerialization serialization() const { return serialization_; }
+  [[nodiscard]] double progress() const {
     return file_.size() == 0 ? 1.0 : static_cast<double>(file_.position()) / static_cast<double>(file_.size());
   }
-  [[nodiscard]] std::uint64_t skipped_packets() const override { return skipped_; }
+  [[nodiscard]] std::uint64_t skipped() const { return skipped_; }
 
  private:
   /// The next record of the data section, from the current chunk or the file; false at its end.
@@ -195,19 +205,18 @@ class McapSource final : public PacketSource {
   }
 
   void consider(std::uint16_t id, const Channel& channel) {
-    if (channel_id_ >= 0) return;
+    if (channel_id_ >= 0 || (!wanted_.empty() && channel.topic != wanted_)) return;
     const bool ros1 = channel.encoding == "ros1", cdr = channel.encoding == "cdr";
-    const RosSerialization serialization = ros1 ? RosSerialization::Ros1 : RosSerialization::Cdr;
-    auto layout = ros1 || cdr ? RosEventLayout::of(serialization, channel.type, channel.definition) : std::nullopt;
-    if (!(wanted_.empty() ? layout.has_value() : channel.topic == wanted_)) return;
-    if (!layout) {
+    if (!((ros1 || cdr) && accepts_(channel.type, channel.encoding, channel.definition))) {
+      if (wanted_.empty()) return;
       throw std::runtime_error("'" + path_ + "': channel " + channel.topic + " is of type " + channel.type + " (" + channel.encoding +
-                               "), not an event type evldt reads");
+                               "), not " + expected_);
     }
     channel_id_ = id;
     topic_ = channel.topic;
     type_ = channel.type;
-    layout_ = std::move(layout);
+    definition_ = channel.definition;
+    serialization_ = ros1 ? RosSerialization::Ros1 : RosSerialization::Cdr;
   }
 
   void open_chunk(FieldReader& fields, std::uint64_t offset) {
@@ -248,16 +257,88 @@ class McapSource final : public PacketSource {
   std::map<std::uint16_t, Schema> schemas_;
   std::map<std::uint16_t, Channel> channels_;
   int channel_id_ = -1;
-  std::string topic_, type_, camera_;
-  std::optional<RosEventLayout> layout_;
-  std::vector<std::uint8_t> scratch_;
+  Accepts accepts_;
+  std::string kind_, expected_;
+  std::string topic_, type_, definition_;
+  RosSerialization serialization_ = RosSerialization::Cdr;
   std::uint64_t read_ = 0, skipped_ = 0;
+};
+
+class McapSource final : public PacketSource {
+ public:
+  McapSource(const std::filesystem::path& path, const std::string& topic)
+      : channel_(path, topic, [](const std::string& type, const std::string& encoding, const std::string& definition) {
+          return RosEventLayout::of(serialization_of(encoding), type, definition).has_value();
+        }, "an event type", "an event type evldt reads"),
+        layout_(*RosEventLayout::of(channel_.serialization(), channel_.type(), channel_.definition())) {}
+
+  bool next(RecordingPacket& packet) override {
+    std::span<const std::uint8_t> message;
+    std::uint64_t offset = 0;
+    if (!channel_.next(message, packet.location, offset)) return false;
+    try {
+      const RosEventMessage decoded = layout_.decode(message, scratch_);
+      fill_packet(decoded, packet);
+      if (camera_.empty()) camera_ = decoded.frame_id;
+    } catch (const std::runtime_error& error) {
+      throw FormatError(channel_.path(), offset, packet.location + ": " + error.what());
+    }
+    return true;
+  }
+
+  [[nodiscard]] std::optional<SensorSize> geometry() const override { return std::nullopt; }  // in the messages
+  [[nodiscard]] std::string camera() const override { return camera_; }
+  [[nodiscard]] std::string description() const override { return "MCAP, " + channel_.topic() + " (" + channel_.type() + ")"; }
+  [[nodiscard]] double progress() const override { return channel_.progress(); }
+  [[nodiscard]] std::uint64_t skipped_packets() const override { return channel_.skipped(); }
+
+ private:
+  static RosSerialization serialization_of(const std::string& encoding) {
+    return encoding == "ros1" ? RosSerialization::Ros1 : RosSerialization::Cdr;
+  }
+
+  McapChannel channel_;
+  RosEventLayout layout_;
+  std::string camera_;
+  std::vector<std::uint8_t> scratch_;
+};
+
+class McapImageSource final : public ImageSource {
+ public:
+  McapImageSource(const std::filesystem::path& path, const std::string& topic)
+      : channel_(path, topic, [](const std::string& type, const std::string&, const std::string&) {
+          return type == kRos2ImageType || type == kRos1ImageType;
+        }, "type " + std::string(kRos2ImageType), std::string(kRos2ImageType)) {}
+
+  bool next(RecordingImage& image, std::string& location) override {
+    std::span<const std::uint8_t> message;
+    std::uint64_t offset = 0;
+    try {
+      if (!channel_.next(message, location, offset)) return false;
+      location = channel_.path() + ", " + location;
+      image = decode_ros_image(channel_.serialization(), message);
+    } catch (const FormatError& error) {
+      throw std::runtime_error(error.what());
+    } catch (const std::runtime_error& error) {
+      throw std::runtime_error(location + ": " + error.what());
+    }
+    return true;
+  }
+
+  [[nodiscard]] std::string description() const override { return "MCAP, " + channel_.topic() + " (" + channel_.type() + ")"; }
+
+ private:
+  McapChannel channel_;
 };
 
 }  // namespace
 
 std::unique_ptr<PacketSource> open_mcap(const std::filesystem::path& path, const std::string& topic) {
   return std::make_unique<McapSource>(path, topic);
+}
+
+std::unique_ptr<ImageSource> open_mcap_images(const std::filesystem::path& path, const std::string& topic) {
+  return std::make_unique<McapImageSource>(path, topic);
 }
 
 }  // namespace evldt

@@ -1,4 +1,4 @@
-// Frames from containers that hold images beside events (ROS 1 and 2 bags, MVSEC's HDF5): each image,
+// Frames from containers that hold images beside events (ROS 1 and 2 bags, MCAP, MVSEC's HDF5): each image,
 // through the conversion its pixel encoding names, to the 8-bit grey frame LSD runs on.
 
 
@@ -93,7 +93,7 @@ std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, cons
     throw FrameError(error.what());
   }
   if (!images) {
-    throw FrameError(path.string() + ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 or 2 bag, MVSEC's HDF5)");
+    throw FrameError(path.string() + ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 or 2 bag or MCAP file, MVSEC's HDF5)");
   }
   return std::make_unique<ImageFrameReader>(std::move(images), sensor);
 }

@@ -20,4 +20,10 @@ inline constexpr std::string_view kMcapMagic{"\x89MCAP0\r\n", 8};
 /// channel (listing its channels).
 std::unique_ptr<PacketSource> open_mcap(const std::filesystem::path& path, const std::string& topic);
 
+class ImageSource;
+/// The sensor_msgs/(msg/)Image messages of a channel (`topic`; empty: the first of that type), in
+/// CDR or ROS 1 serialization, in file order. Throws std::runtime_error naming the file if it is no
+/// MCAP file or has no such channel.
+std::unique_ptr<ImageSource> open_mcap_images(const std::filesystem::path& path, const std::string& topic);
+
 }  // namespace evldt

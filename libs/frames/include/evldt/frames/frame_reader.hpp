@@ -2,7 +2,7 @@
 // Intensity frames a recording holds beside its events (a DAVIS's APS frames, a simulator's
 // renderings), pixel-aligned with the events: the ground truth the paper draws lines from (issue 28).
 // A reader per container, behind one interface, as the event readers are: the Event Camera
-// Dataset's folder layout; sensor_msgs/Image in ROS 1 and 2 bags and MVSEC's HDF5 frames, whose
+// Dataset's folder layout; sensor_msgs/Image in ROS 1 and 2 bags (.db3, MCAP) and MVSEC's HDF5 frames, whose
 // containers (libs/containers) yield images that are converted here by their pixel encoding.
 
 #include <filesystem>
@@ -45,7 +45,7 @@ class FrameReader {
 std::unique_ptr<FrameReader> open_ecd_frames(const std::filesystem::path& path, SensorSize sensor);
 
 /// The frames of `path`, whichever container it is: an ECD folder (or its images.txt); a ROS 1 or
-/// ROS 2 (.db3) bag's sensor_msgs/Image topic `stream` (empty: the first; pixel encodings mono8,
+/// ROS 2 bag's (.db3 or MCAP) sensor_msgs/Image topic `stream` (empty: the first; pixel encodings mono8,
 /// mono16 (its high byte), bgr8 and rgb8, as grey); MVSEC's HDF5 frames `stream` (empty:
 /// /davis/left/image_raw, with its _ts times). Throws FrameError naming the path for anything else or a container without them.
 std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream, SensorSize sensor);
