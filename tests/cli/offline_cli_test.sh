@@ -158,5 +158,6 @@ status=$?
 set -e
 [[ $status -eq 1 ]] || fail "--frames-gt of a file that holds no frames must exit 1, got $status"
 grep -q "junk.bin: not a source of frames evldt reads" "$work/frames_junk.txt" || fail "junk frames: $(cat "$work/frames_junk.txt")"
+grep -Eq "WARN|ERROR:" "$work/frames_junk.txt" && fail "OpenCV's own messages leaked: $(cat "$work/frames_junk.txt")"
 echo "ok: frames written at 100 Hz, LSD on them F@1% $lsd_f against the exact lines; a missing frame is named, a file of no frames refused"
 echo "offline CLI: 11 passed, 0 failed"

@@ -15,6 +15,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "evldt/eval/frame_ground_truth.hpp"
 #include "evldt/frames/frame_reader.hpp"
@@ -350,6 +351,29 @@ TEST_F(FramesTest, MvsecHdf5BadInputsAreClearErrors) {
   EXPECT_NE(error().find("is not N x H x W frames of 8-bit pixels"), std::string::npos) << error();
   write_mvsec_frames(path, {square(4)}, {std::nan("")});
   EXPECT_NE(error().find("image_raw[0]: its time"), std::string::npos) << error();
+}
+
+// A video's frames on the clock --from-video emulates its events on (frame k at k / fps s).
+TEST_F(FramesTest, VideoFramesOnTheClockOfTheEventsEmulatedFromThem) {
+  std::filesystem::create_directories(folder_);
+  const std::filesystem::path path = folder_ / "clip.avi";
+  {
+    cv::VideoWriter writer(path.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25, cv::Size(kSensor.width, kSensor.height), false);
+    ASSERT_TRUE(writer.isOpened());
+    for (int k = 0; k < 4; ++k) writer.write(square(4 + 6 * k));
+  }
+  const auto reader = open_frames(path, "", kSensor);
+  for (int k = 0; k < 4; ++k) {
+    const auto frame = reader->next();
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->t_us, 40'000 * k);
+    EXPECT_EQ(frame->t_us, video_frame_time_us(static_cast<std::uint64_t>(k), 25));
+    ASSERT_EQ(frame->image.type(), CV_8UC1);
+    EXPECT_LT(cv::norm(frame->image, square(4 + 6 * k), cv::NORM_L1) / static_cast<double>(frame->image.total()), 3.0) << frame->name;  // JPEG
+  }
+  EXPECT_FALSE(reader->next());
+  const auto small = open_frames(path, "", SensorSize{32, 24});
+  EXPECT_THROW(small->next(), FrameError);
 }
 
 TEST_F(FramesTest, LsdFindsTheSidesOfASquare) {

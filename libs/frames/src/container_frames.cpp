@@ -6,6 +6,7 @@
 
 #include "evldt/containers/image_source.hpp"
 #include "evldt/frames/frame_reader.hpp"
+#include "video_frames.hpp"
 
 namespace evldt {
 namespace {
@@ -92,10 +93,10 @@ std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, cons
   } catch (const std::runtime_error& error) {
     throw FrameError(error.what());
   }
-  if (!images) {
-    throw FrameError(path.string() + ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 or 2 bag or MCAP file, MVSEC's HDF5)");
-  }
-  return std::make_unique<ImageFrameReader>(std::move(images), sensor);
+  if (images) return std::make_unique<ImageFrameReader>(std::move(images), sensor);
+  if (auto video = open_video_frames(path, sensor)) return video;
+  throw FrameError(path.string() + ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 or 2 bag or MCAP "
+                   "file, MVSEC's HDF5, a video file)");
 }
 
 }  // namespace evldt

@@ -13,6 +13,7 @@
 #include "evldt/containers/hdf5_events.hpp"
 #include "evldt/containers/packet_source.hpp"
 #include "evldt/events/event_stream_reader.hpp"
+#include "evldt/frames/frame_reader.hpp"
 #include <spdlog/spdlog.h>
 #include "evldt/transport/lcm_log.hpp"
 
@@ -235,7 +236,7 @@ class VideoSource final : public EventSource {
     }
     if (grey_.depth() != CV_8U) grey_.convertTo(grey_, CV_8U);
     const Timestamp t = live_ ? std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - started_).count()
-                              : static_cast<Timestamp>(static_cast<double>(frames_) * 1e6 / fps_);
+                              : video_frame_time_us(frames_, fps_);
     // Frame times must increase; a webcam may deliver two frames within a microsecond.
     const Timestamp frame_t = std::max(t, last_t_ + 1);
     last_t_ = frame_t;

@@ -2,8 +2,9 @@
 // Intensity frames a recording holds beside its events (a DAVIS's APS frames, a simulator's
 // renderings), pixel-aligned with the events: the ground truth the paper draws lines from (issue 28).
 // A reader per container, behind one interface, as the event readers are: the Event Camera
-// Dataset's folder layout; sensor_msgs/Image in ROS 1 and 2 bags (.db3, MCAP) and MVSEC's HDF5 frames, whose
-// containers (libs/containers) yield images that are converted here by their pixel encoding.
+// Dataset's folder layout; sensor_msgs/Image in ROS 1 and 2 bags (.db3, MCAP) and MVSEC's HDF5
+// frames, whose containers (libs/containers) yield images that are converted here by their pixel
+// encoding; video files, whose frames are those events are emulated from (--from-video).
 
 #include <filesystem>
 #include <memory>
@@ -44,10 +45,16 @@ class FrameReader {
 /// FrameError when there is no images.txt.
 std::unique_ptr<FrameReader> open_ecd_frames(const std::filesystem::path& path, SensorSize sensor);
 
+/// The time of frame `index` of a video file at `fps` frames a second: the clock of the frames read
+/// here and of the events emulated from the video (libs/sources).
+Timestamp video_frame_time_us(std::uint64_t index, double fps);
+
 /// The frames of `path`, whichever container it is: an ECD folder (or its images.txt); a ROS 1 or
-/// ROS 2 bag's (.db3 or MCAP) sensor_msgs/Image topic `stream` (empty: the first; pixel encodings mono8,
-/// mono16 (its high byte), bgr8 and rgb8, as grey); MVSEC's HDF5 frames `stream` (empty:
-/// /davis/left/image_raw, with its _ts times). Throws FrameError naming the path for anything else or a container without them.
+/// ROS 2 bag's (.db3 or MCAP) sensor_msgs/Image topic `stream` (empty: the first; pixel encodings
+/// mono8, mono16 (its high byte), bgr8 and rgb8, as grey); MVSEC's HDF5 frames `stream` (empty:
+/// /davis/left/image_raw, with its _ts times); else a video file OpenCV opens (as grey, at its
+/// frame rate, else 30 fps, as --from-video emulates events from it). Throws FrameError naming the
+/// path for anything else or a container without them.
 std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream, SensorSize sensor);
 
 }  // namespace evldt
