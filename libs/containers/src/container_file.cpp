@@ -1,5 +1,6 @@
 #include "container_file.hpp"
 
+#include <fstream>
 #include <span>
 #include <stdexcept>
 #include <vector>
@@ -61,6 +62,15 @@ void ContainerStream::skip(std::uint64_t size) {
     read_exactly(discarded.data(), part, "a skipped packet");
     left -= part;
   }
+}
+
+std::optional<std::string> container_magic(const std::filesystem::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return std::nullopt;
+  std::string magic(16, '\0');
+  file.read(magic.data(), static_cast<std::streamsize>(magic.size()));
+  magic.resize(static_cast<std::size_t>(file.gcount()));
+  return magic;
 }
 
 }  // namespace evldt::detail

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "evldt/events/byte_source.hpp"
@@ -58,5 +59,9 @@ class ContainerStream final : public ContainerInput {
  private:
   std::unique_ptr<ByteSource> bytes_;
 };
+
+/// The first 16 bytes of `path` (fewer in a shorter file), by which a container is recognised;
+/// nullopt when it cannot be opened.
+std::optional<std::string> container_magic(const std::filesystem::path& path);
 
 }  // namespace evldt::detail

@@ -1,9 +1,8 @@
 #include "evldt/containers/image_source.hpp"
 
-#include <array>
-#include <fstream>
 #include <string_view>
 
+#include "container_file.hpp"
 #include "evldt/containers/hdf5_events.hpp"
 #include "evldt/containers/hdf5_images.hpp"
 #include "evldt/containers/mcap.hpp"
@@ -13,11 +12,9 @@
 namespace evldt {
 
 std::unique_ptr<ImageSource> open_image_container(const std::filesystem::path& path, const std::string& stream) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return nullptr;
-  std::array<char, 16> magic{};
-  file.read(magic.data(), magic.size());
-  const std::string_view start(magic.data(), static_cast<std::size_t>(file.gcount()));
+  const auto magic = detail::container_magic(path);
+  if (!magic) return nullptr;
+  const std::string_view start = *magic;
   if (start.starts_with(kRosbag1Magic)) return open_rosbag1_images(path, stream);
   if (start.starts_with(kSqliteMagic)) return open_rosbag2_images(path, stream);
   if (start.starts_with(kHdf5Magic)) return open_hdf5_images(path, stream);

@@ -1,10 +1,9 @@
 #include "evldt/containers/packet_source.hpp"
 
-#include <array>
 #include <cstring>
-#include <fstream>
 #include <utility>
 
+#include "container_file.hpp"
 #include "evldt/containers/aedat4.hpp"
 #include "evldt/containers/mcap.hpp"
 #include "evldt/containers/rosbag1.hpp"
@@ -91,11 +90,9 @@ DecodeCounts PacketEventReader::counts() const {
 }
 
 std::unique_ptr<PacketSource> open_packet_container(const std::filesystem::path& path, const std::string& topic) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return nullptr;
-  std::array<char, 16> magic{};
-  file.read(magic.data(), magic.size());
-  const std::string_view start(magic.data(), static_cast<std::size_t>(file.gcount()));
+  const auto magic = detail::container_magic(path);
+  if (!magic) return nullptr;
+  const std::string_view start = *magic;
   if (start.starts_with(kSqliteMagic)) return open_rosbag2(path, topic);
   if (start.starts_with(kAedat4Magic)) return open_aedat4(path);
   if (start.starts_with(kRosbag1Magic)) return open_rosbag1(path, topic);
