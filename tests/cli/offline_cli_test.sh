@@ -135,6 +135,17 @@ echo "ok: empty prediction -> P n/a, R 0, F 0; one step -> recall $one_step_reca
 lsd_f=$(awk '$2 == "lsd/exact" { print $6 }' "$work/frames.txt")
 awk -v f="$lsd_f" 'BEGIN { exit !(f > 0.9) }' || fail "LSD on the frames against the exact lines: $(cat "$work/frames.txt")"
 grep -q "ground truth: LSD on 21 frames" "$work/frames.err" || fail "frames ground truth not announced: $(cat "$work/frames.err")"
+# Frames as a real APS takes them: blurred over a 10 ms exposure, with read noise; LSD still finds the lines.
+"$sim" --scene three-lines-fast --duration-s 0.2 --frames-hz 100 --frames-exposure-us 10000 --frames-noise 3 --format ecd \
+  --out-dir "$work/frames_aps" -q >/dev/null
+[[ -f "$work/frames_aps/images/frame_00000010.png" ]] || fail "no frame 10 with --frames-exposure-us"
+cmp -s "$work/frames/images/frame_00000010.png" "$work/frames_aps/images/frame_00000010.png" && fail "--frames-exposure-us / --frames-noise changed nothing"
+"$eval" --scene three-lines-fast --duration-s 0.2 --frames-gt "$work/frames_aps" >"$work/frames_aps.txt" 2>/dev/null
+awk '$2 == "lsd/exact" { found = 1; if ($6 <= 0.9) exit 1 } END { exit !found }' "$work/frames_aps.txt" ||
+  fail "LSD on blurred, noisy frames against the exact lines: $(cat "$work/frames_aps.txt")"
+if "$sim" --scene three-lines-fast --frames-hz 100 --frames-exposure-us -1 --out-dir "$work/bad_aps" -q >/dev/null 2>&1; then
+  fail "a negative exposure must be refused"
+fi
 # The same lines written out (--write-gt) score a segment file as the frames do; the paper's view per second.
 "$offline" "$work/frames/events.txt" --width 640 --height 480 -q --output-period-us 10000 -o "$work/frames_seg.csv" >/dev/null
 "$eval" --segments "$work/frames_seg.csv" --frames-gt "$work/frames" --width 640 --height 480 --write-gt "$work/lsd_gt.csv" \

@@ -389,6 +389,31 @@ TEST_F(FramesTest, LsdFindsTheSidesOfASquare) {
   EXPECT_TRUE(lsd_segments(square(20), long_only).empty());  // the sides are 24 px
 }
 
+// An APS frame as a real one: a moving edge blurred across what it moved during the exposure, and
+// read noise, the same for the same seed and time.
+TEST_F(FramesTest, SimulatedFramesBlurWithTheExposureAndCarryReadNoise) {
+  const Scene scene = make_scene("three-lines-fast");
+  const EventSimulator simulator(scene, SimulatorConfig{});
+  const auto grey_levels = [&](const std::vector<std::uint8_t>& grey) {  // pixels strictly between dark and bright
+    return std::count_if(grey.begin(), grey.end(), [](std::uint8_t v) { return v > 40 && v < 200; });
+  };
+  std::vector<std::uint8_t> sharp, blurred, noisy, again;
+  simulator.render_frame(100'000, sharp);
+  simulator.render_frame(100'000, blurred, {.exposure_us = 10'000});
+  EXPECT_GT(grey_levels(blurred), 2 * grey_levels(sharp));  // the lines move fast: wide ramps instead of steps
+  simulator.render_frame(100'000, noisy, {.read_noise = 5});
+  simulator.render_frame(100'000, again, {.read_noise = 5});
+  EXPECT_EQ(noisy, again);
+  double sum = 0, squares = 0;
+  for (std::size_t i = 0; i < sharp.size(); ++i) {
+    const double d = static_cast<double>(noisy[i]) - static_cast<double>(sharp[i]);
+    sum += d;
+    squares += d * d;
+  }
+  const double n = static_cast<double>(sharp.size());
+  EXPECT_NEAR(std::sqrt(squares / n - (sum / n) * (sum / n)), 5.0, 1.0);  // clipped at 0 and 255 a little
+}
+
 // The whole chain: the simulator's frames, written and read back, LSD on them, scored against
 // the scene's exact lines: the imitation the paper relies on is close on a scene of clean edges.
 TEST_F(FramesTest, LsdOnSimulatedFramesMatchesTheExactLines) {

@@ -33,7 +33,7 @@ std::filesystem::path file_for(EventFormat format) {
 }
 
 int run(const SimulatorOptions& sim_options, const std::filesystem::path& out_dir, const std::vector<std::string>& formats,
-        Timestamp gt_period_us, double frames_hz, bool quiet) {
+        Timestamp gt_period_us, double frames_hz, const ApsModel& aps, bool quiet) {
   const Scene scene = sim_options.scene();
   std::filesystem::create_directories(out_dir);
   std::vector<std::unique_ptr<EventWriter>> writers;
@@ -73,7 +73,7 @@ int run(const SimulatorOptions& sim_options, const std::filesystem::path& out_di
     const double period_us = 1e6 / frames_hz;
     for (; static_cast<double>(frames) * period_us <= static_cast<double>(scene.duration_us); ++frames) {
       const auto t = static_cast<Timestamp>(std::llround(static_cast<double>(frames) * period_us));
-      simulator.render_frame(t, grey);
+      simulator.render_frame(t, grey, aps);
       frame_writer.write(t, cv::Mat(scene.sensor.height, scene.sensor.width, CV_8UC1, grey.data()));
     }
     frame_writer.close();
@@ -107,6 +107,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> formats{"evt3", "ecd"};
   Timestamp gt_period_us = 10000;
   double frames_hz = 0;
+  ApsModel aps;
   bool quiet = false;
   bool list = false;
   sim_options.add_to(app, /*scene_required=*/true);
@@ -122,10 +123,17 @@ int main(int argc, char** argv) {
                  "with the events, for evldt-eval --frames-gt (0: none)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10000.0));
+  app.add_option("--frames-exposure-us", aps.exposure_us,
+                 "Exposure of each frame, centred on its time: motion blurs edges as on a real APS (0: an instant)")
+      ->capture_default_str()
+      ->check(CLI::Range(Timestamp{0}, Timestamp{1'000'000}));
+  app.add_option("--frames-noise", aps.read_noise, "Read noise added to each frame's pixels, standard deviation in grey levels")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 255.0));
   app.add_flag("--list", list, "List the built-in scenes and exit");
   app.add_flag("-q,--quiet", quiet, "No progress lines");
   return run_main(app, argc, argv, [&] {
-    if (!list) return run(sim_options, out_dir, formats, gt_period_us, frames_hz, quiet);
+    if (!list) return run(sim_options, out_dir, formats, gt_period_us, frames_hz, aps, quiet);
     for (const auto& name : scene_names()) {
       const Scene s = make_scene(name);
       std::printf("%-18s %dx%d  %.2f s  %zu shapes%s\n", name.c_str(), s.sensor.width, s.sensor.height,

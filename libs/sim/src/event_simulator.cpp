@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <tuple>
 
@@ -78,13 +79,25 @@ void EventSimulator::render(Timestamp t_us, std::vector<float>& log_image) const
   }
 }
 
-void EventSimulator::render_frame(Timestamp t_us, std::vector<std::uint8_t>& grey) const {
-  std::vector<float> log_image(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_));
-  render(t_us, log_image);
-  grey.resize(log_image.size());
-  for (std::size_t i = 0; i < log_image.size(); ++i) {
-    const double brightness = std::clamp(std::exp(static_cast<double>(log_image[i])) - kDarkCurrent, 0.0, 1.0);
-    grey[i] = static_cast<std::uint8_t>(std::lround(brightness * 255.0));
+void EventSimulator::render_frame(Timestamp t_us, std::vector<std::uint8_t>& grey, const ApsModel& aps) const {
+  const std::size_t pixels = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  std::vector<float> log_image(pixels);
+  std::vector<double> brightness(pixels, 0.0);
+  // The exposure as the mean of instants across it, one per 250 us (at least 1, at most 32).
+  const int instants = aps.exposure_us <= 0 ? 1 : static_cast<int>(std::clamp<Timestamp>(aps.exposure_us / 250, 2, 32));
+  for (int k = 0; k < instants; ++k) {
+    const Timestamp at = instants == 1 ? t_us : t_us - aps.exposure_us / 2 + aps.exposure_us * (2 * k + 1) / (2 * instants);
+    render(at, log_image);
+    for (std::size_t i = 0; i < pixels; ++i) {
+      brightness[i] += std::clamp(std::exp(static_cast<double>(log_image[i])) - kDarkCurrent, 0.0, 1.0) / instants;
+    }
+  }
+  std::mt19937_64 rng(config_.seed * 0x9e3779b97f4a7c15ULL ^ static_cast<std::uint64_t>(t_us));
+  std::normal_distribution<double> noise(0.0, aps.read_noise > 0 ? aps.read_noise : 1.0);
+  grey.resize(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const double level = brightness[i] * 255.0 + (aps.read_noise > 0 ? noise(rng) : 0.0);
+    grey[i] = static_cast<std::uint8_t>(std::lround(std::clamp(level, 0.0, 255.0)));
   }
 }
 

@@ -43,6 +43,13 @@ struct SimulatorCounters {
   std::uint64_t sub_frames = 0;
 };
 
+/// How an APS takes a frame: the exposure it integrates over (motion blurs an edge across what it
+/// moves meanwhile) and the read noise added to each pixel.
+struct ApsModel {
+  Timestamp exposure_us = 0;  ///< 0: an instant
+  double read_noise = 0;      ///< standard deviation, in grey levels (0..255)
+};
+
 class EventSimulator {
  public:
   EventSimulator(Scene scene, const SimulatorConfig& config);
@@ -52,9 +59,10 @@ class EventSimulator {
   /// follow the scene, not the calls, so any split of the time range gives the same events.
   bool run_until(Timestamp until_us, EventBatch& out);
 
-  /// The scene at `t_us` as an 8-bit grey frame (row-major, the sensor's size), brightness 0..1 to
-  /// 0..255: what a DAVIS's APS would see, pixel-aligned with the events. Any time, in any order.
-  void render_frame(Timestamp t_us, std::vector<std::uint8_t>& grey) const;
+  /// The scene at `t_us` (the exposure's middle) as an 8-bit grey frame (row-major, the sensor's
+  /// size), brightness 0..1 to 0..255: what a DAVIS's APS would see, pixel-aligned with the events.
+  /// Any time, in any order; the noise is the same for the same seed and time.
+  void render_frame(Timestamp t_us, std::vector<std::uint8_t>& grey, const ApsModel& aps = {}) const;
 
   [[nodiscard]] Timestamp now_us() const { return now_; }
   [[nodiscard]] const Scene& scene() const { return scene_; }
