@@ -351,6 +351,8 @@ TEST_F(FramesTest, MvsecHdf5BadInputsAreClearErrors) {
   EXPECT_NE(error().find("is not N x H x W frames of 8-bit pixels"), std::string::npos) << error();
   write_mvsec_frames(path, {square(4)}, {std::nan("")});
   EXPECT_NE(error().find("image_raw[0]: its time"), std::string::npos) << error();
+  write_mvsec_frames(path, {cv::Mat(1, 5000, CV_8UC1, cv::Scalar(0))}, {1.0});
+  EXPECT_NE(error().find("holds frames of 5000x1, not a sensor's size"), std::string::npos) << error();
 }
 
 // A video's frames on the clock --from-video emulates its events on (frame k at k / fps s).

@@ -29,6 +29,11 @@ class Hdf5ImageSource final : public ImageSource {
         throw std::runtime_error(name_ + " is not N x H x W frames of 8-bit pixels");
       }
       H5Sget_simple_extent_dims(space.get(), dims_.data(), nullptr);
+      // Checked before any frame is read into memory: a corrupt size must not become an allocation.
+      if (dims_[1] < 1 || dims_[2] < 1 || dims_[1] > kMaxSensorSide || dims_[2] > kMaxSensorSide) {
+        throw std::runtime_error(name_ + " holds frames of " + std::to_string(dims_[2]) + "x" + std::to_string(dims_[1]) +
+                                 ", not a sensor's size (1.." + std::to_string(kMaxSensorSide) + " a side)");
+      }
       const std::string times_name = name_ + "_ts";
       if (!hdf5::exists(file_.get(), times_name)) throw std::runtime_error("no frame times " + times_name);
       const Handle times(H5Dopen2(file_.get(), times_name.c_str(), H5P_DEFAULT));
