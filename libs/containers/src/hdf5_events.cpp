@@ -21,6 +21,7 @@ namespace {
 using hdf5::Handle;
 using hdf5::exists;
 using hdf5::hdf5_error;
+using hdf5::time_us;
 
 constexpr std::size_t kSlabEvents = std::size_t{1} << 16;
 constexpr H5Z_filter_t kBloscFilter = 32001;
@@ -105,20 +106,12 @@ std::optional<SensorSize> sensor_from_attributes(hid_t object) {
 // outside 0..65535 (or NaN) becomes 65535, off every sensor, for the validator to drop and count.
 std::uint16_t coordinate(double value) { return value >= 0 && value <= 65535 ? static_cast<std::uint16_t>(std::lround(value)) : 65535; }
 
-Timestamp saturated(double us) {
-  constexpr double kLimit = 9.2e18;  // inside the int64 range
-  if (std::isnan(us)) return 0;
-  return static_cast<Timestamp>(std::clamp(std::round(us), -kLimit, kLimit));
-}
-
 Timestamp saturated_sum(Timestamp a, Timestamp b) {
   Timestamp sum = 0;
   if (__builtin_add_overflow(a, b, &sum)) return b > 0 ? std::numeric_limits<Timestamp>::max() : std::numeric_limits<Timestamp>::min();
   return sum;
 }
 
-/// Integer times are us, floating-point times seconds.
-Timestamp time_us(double value, bool seconds) { return saturated(seconds ? value * 1e6 : value); }
 
 }  // namespace
 

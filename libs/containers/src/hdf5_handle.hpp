@@ -1,10 +1,15 @@
 #pragma once
-// What the HDF5 readers share: identifiers released by scope, and HDF5's own reason for a failure.
+// What the HDF5 readers share: identifiers released by scope, HDF5's own reason for a failure, and
+// the reading of a time from a file's untrusted values.
 
 #include <hdf5.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
+
+#include "evldt/events/event.hpp"
 
 namespace evldt::hdf5 {
 
@@ -57,5 +62,15 @@ inline bool exists(hid_t file, const std::string& path) {
   }
   return !path.empty();
 }
+
+/// A time in us: saturates instead of overflowing, NaN becomes 0.
+inline Timestamp saturated(double us) {
+  constexpr double kLimit = 9.2e18;  // inside the int64 range
+  if (std::isnan(us)) return 0;
+  return static_cast<Timestamp>(std::clamp(std::round(us), -kLimit, kLimit));
+}
+
+/// Integer times are us, floating-point times seconds.
+inline Timestamp time_us(double value, bool seconds) { return saturated(seconds ? value * 1e6 : value); }
 
 }  // namespace evldt::hdf5

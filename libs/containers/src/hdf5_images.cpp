@@ -66,7 +66,7 @@ class Hdf5ImageSource final : public ImageSource {
     }
     const double seconds = seconds_[next_];
     if (!std::isfinite(seconds) || std::abs(seconds) > 9e12) throw std::runtime_error(location + ": its time " + std::to_string(seconds) + " s is no time");
-    image.t_us = std::llround(seconds * 1e6);  // as the events' times in seconds are read
+    image.t_us = hdf5::time_us(seconds, true);  // as the events' times in seconds are read
     image.width = static_cast<std::uint32_t>(dims_[2]);
     image.height = static_cast<std::uint32_t>(dims_[1]);
     image.encoding = "mono8";

@@ -65,12 +65,13 @@ struct Schema {
 };
 
 /// One channel of an MCAP file, its messages read in file order: the channel `wanted`, or if empty
-/// the first that `accepts` (given its type, message encoding and schema definition). For errors,
+/// the first that `accepts` (given its type, serialization and schema definition; channels in
+/// neither ROS serialization are never accepted). For errors,
 /// `kind` names what it looks for ("an event type") and `expected` the types it accepts. Throws
 /// std::runtime_error naming the file for a file it cannot read or no such channel.
 class McapChannel {
  public:
-  using Accepts = std::function<bool(const std::string& type, const std::string& encoding, const std::string& definition)>;
+  using Accepts = std::function<bool(const std::string& type, RosSerialization serialization, const std::string& definition)>;
   McapChannel(const std::filesystem::path& path, const std::string& topic, Accepts accepts, std::string kind, std::string expected)
       : file_(path, "MCAP"), path_(file_.path()), wanted_(topic), accepts_(std::move(accepts)), kind_(std::move(kind)),
         expected_(std::move(expected)) {
@@ -207,7 +208,8 @@ class McapChannel {
   void consider(std::uint16_t id, const Channel& channel) {
     if (channel_id_ >= 0 || (!wanted_.empty() && channel.topic != wanted_)) return;
     const bool ros1 = channel.encoding == "ros1", cdr = channel.encoding == "cdr";
-    if (!((ros1 || cdr) && accepts_(channel.type, channel.encoding, channel.definition))) {
+    const RosSerialization serialization = ros1 ? RosSerialization::Ros1 : RosSerialization::Cdr;
+    if (!((ros1 || cdr) && accepts_(channel.type, serialization, channel.definition))) {
       if (wanted_.empty()) return;
       throw std::runtime_error("'" + path_ + "': channel " + channel.topic + " is of type " + channel.type + " (" + channel.encoding +
                                "), not " + expected_);
@@ -216,7 +218,7 @@ class McapChannel {
     topic_ = channel.topic;
     type_ = channel.type;
     definition_ = channel.definition;
-    serialization_ = ros1 ? RosSerialization::Ros1 : RosSerialization::Cdr;
+    serialization_ = serialization;
   }
 
   void open_chunk(FieldReader& fields, std::uint64_t offset) {
@@ -267,8 +269,8 @@ class McapChannel {
 class McapSource final : public PacketSource {
  public:
   McapSource(const std::filesystem::path& path, const std::string& topic)
-      : channel_(path, topic, [](const std::string& type, const std::string& encoding, const std::string& definition) {
-          return RosEventLayout::of(serialization_of(encoding), type, definition).has_value();
+      : channel_(path, topic, [](const std::string& type, RosSerialization serialization, const std::string& definition) {
+          return RosEventLayout::of(serialization, type, definition).has_value();
         }, "an event type", "an event type evldt reads"),
         layout_(*RosEventLayout::of(channel_.serialization(), channel_.type(), channel_.definition())) {}
 
@@ -293,10 +295,6 @@ class McapSource final : public PacketSource {
   [[nodiscard]] std::uint64_t skipped_packets() const override { return channel_.skipped(); }
 
  private:
-  static RosSerialization serialization_of(const std::string& encoding) {
-    return encoding == "ros1" ? RosSerialization::Ros1 : RosSerialization::Cdr;
-  }
-
   McapChannel channel_;
   RosEventLayout layout_;
   std::string camera_;
@@ -306,7 +304,7 @@ class McapSource final : public PacketSource {
 class McapImageSource final : public ImageSource {
  public:
   McapImageSource(const std::filesystem::path& path, const std::string& topic)
-      : channel_(path, topic, [](const std::string& type, const std::string&, const std::string&) {
+      : channel_(path, topic, [](const std::string& type, RosSerialization, const std::string&) {
           return type == kRos2ImageType || type == kRos1ImageType;
         }, "type " + std::string(kRos2ImageType), std::string(kRos2ImageType)) {}
 
