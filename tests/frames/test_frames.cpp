@@ -1,7 +1,8 @@
 // Intensity frames (issue 28): the ECD layout written and read back, sensor_msgs/Image in ROS 1
 // bags written with rosbag_storage and in ROS 2 bags (CDR in SQLite) written from the message's
-// description, MVSEC's HDF5 frames written
-// with the HDF5 library, their bad inputs, and LSD ground truth from the simulator's frames against
+// description, MVSEC's HDF5 frames written with the HDF5 library, AEDAT 3.1 frame packets, jAER's
+// AEDAT 2.0 DAVIS APS samples and AEDAT 4.0 frame streams written from the format descriptions, their
+// bad inputs, and LSD ground truth from the simulator's frames against
 // the scene's exact lines.
 
 #include <gtest/gtest.h>
@@ -17,6 +18,9 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <flatbuffers/flatbuffers.h>
+
+#include "aedat4_header_generated.h"
 #include "evldt/eval/frame_ground_truth.hpp"
 #include "evldt/frames/frame_reader.hpp"
 #include "evldt/frames/frame_writer.hpp"
@@ -353,6 +357,257 @@ TEST_F(FramesTest, MvsecHdf5BadInputsAreClearErrors) {
   EXPECT_NE(error().find("image_raw[0]: its time"), std::string::npos) << error();
   write_mvsec_frames(path, {cv::Mat(1, 5000, CV_8UC1, cv::Scalar(0))}, {1.0});
   EXPECT_NE(error().find("holds frames of 5000x1, not a sensor's size"), std::string::npos) << error();
+}
+
+// ---- AEDAT 3.1 and 2.0, written from the format descriptions (aedat_images.hpp) ----------------
+
+void put16(std::vector<std::uint8_t>& out, std::uint16_t value) {
+  out.push_back(static_cast<std::uint8_t>(value & 0xFF));
+  out.push_back(static_cast<std::uint8_t>(value >> 8));
+}
+void put_be32(std::vector<std::uint8_t>& out, std::uint32_t value) {
+  for (int k = 3; k >= 0; --k) out.push_back(static_cast<std::uint8_t>(value >> (8 * k)));
+}
+void write_bytes(const std::filesystem::path& path, const std::string& header, const std::vector<std::uint8_t>& data) {
+  std::ofstream file(path, std::ios::binary);
+  file << header;
+  file.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
+}
+
+/// An AEDAT 3.1 packet: the 28-byte header, then `capacity` events of `event_size` bytes.
+void put_aedat31_packet(std::vector<std::uint8_t>& out, std::int16_t type, std::int32_t event_size, std::int32_t overflow,
+                        std::int32_t capacity, const std::vector<std::uint8_t>& events) {
+  put16(out, static_cast<std::uint16_t>(type));
+  put16(out, 1);  // source
+  for (const std::int32_t field : {event_size, 4, overflow, capacity, capacity, capacity}) put32(out, static_cast<std::uint32_t>(field));
+  out.insert(out.end(), events.begin(), events.end());
+  out.resize(out.size() + static_cast<std::size_t>(event_size) * static_cast<std::size_t>(capacity) - events.size(), 0);
+}
+
+/// A frame event: info (valid, channels), times, size, position, then the grey image's pixels as
+/// 16-bit values (the grey in the high byte, noise in the low one), padded to `event_size`.
+void put_aedat31_frame(std::vector<std::uint8_t>& out, std::size_t event_size, const cv::Mat& grey, bool valid, std::uint32_t channels,
+                       std::int32_t start_exposure, std::int32_t end_exposure, std::int32_t claimed_width = 0) {
+  const std::size_t start = out.size();
+  put32(out, (valid ? 1u : 0u) | channels << 1);
+  for (const std::int32_t t : {start_exposure - 100, end_exposure + 100, start_exposure, end_exposure}) put32(out, static_cast<std::uint32_t>(t));
+  for (const int field : {claimed_width > 0 ? claimed_width : grey.cols, grey.rows, 0, 0}) put32(out, static_cast<std::uint32_t>(field));
+  for (int y = 0; y < grey.rows; ++y) {
+    for (int x = 0; x < grey.cols; ++x) put16(out, static_cast<std::uint16_t>(grey.at<std::uint8_t>(y, x) << 8 | ((x * 7 + y) & 0xFF)));
+  }
+  out.resize(start + event_size, 0);
+}
+
+const std::string kAedat31Header = "#!AER-DAT3.1\r\n#Format: RAW\r\n#Source 1: DAVIS346B\r\n#!END-HEADER\r\n";
+constexpr std::size_t kFrameEventSize = 36 + 64 * 48 * 2 + 8;  // a frame's header, its pixels and slack
+
+TEST_F(FramesTest, Aedat31FramePacketsReadAtTheMiddleOfTheirExposure) {
+  std::filesystem::create_directories(folder_);
+  std::vector<std::uint8_t> data, polarity, frames;
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    put32(polarity, 1u | 1u << 17 | 2u << 2);
+    put32(polarity, 500 + k);
+  }
+  put_aedat31_packet(data, 1, 8, 1, 2, polarity);  // events: passed over
+  put_aedat31_frame(frames, kFrameEventSize, square(4), true, 1, 1000, 3000);
+  put_aedat31_frame(frames, kFrameEventSize, square(30), false, 1, 4000, 5000);  // invalid: no frame
+  put_aedat31_frame(frames, kFrameEventSize, square(10), true, 1, 40000, 40001);
+  put_aedat31_packet(data, 2, static_cast<std::int32_t>(kFrameEventSize), 1, 3, frames);
+  const auto path = folder_ / "davis.aedat";
+  write_bytes(path, kAedat31Header, data);
+  const auto reader = open_frames(path, "", kSensor);
+  const Timestamp overflow = Timestamp{1} << 31;
+  for (const auto& [t, left] : {std::pair{overflow + 2000, 4}, std::pair{overflow + 40000, 10}}) {
+    const auto frame = reader->next();
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->t_us, t);
+    EXPECT_EQ(cv::norm(frame->image, square(left), cv::NORM_INF), 0.0) << frame->name;
+    EXPECT_NE(frame->name.find("davis.aedat: frame "), std::string::npos) << frame->name;
+  }
+  EXPECT_FALSE(reader->next());
+}
+
+TEST_F(FramesTest, Aedat31BadFramesNameTheFrame) {
+  std::filesystem::create_directories(folder_);
+  const auto path = folder_ / "bad.aedat";
+  const auto error = [&](const std::vector<std::uint8_t>& data) {
+    write_bytes(path, kAedat31Header, data);
+    try {
+      const auto reader = open_frames(path, "", kSensor);
+      while (reader->next()) {
+      }
+    } catch (const FrameError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::vector<std::uint8_t> data, frame;
+  put_aedat31_frame(frame, kFrameEventSize, square(4), true, 3, 1000, 2000);
+  put_aedat31_packet(data, 2, static_cast<std::int32_t>(kFrameEventSize), 0, 1, frame);
+  EXPECT_NE(error(data).find("bad.aedat: frame 0 of the frame packet at byte 64: 3 colour channels"), std::string::npos) << error(data);
+  data.clear();
+  frame.clear();
+  put_aedat31_frame(frame, kFrameEventSize, square(4), true, 1, 1000, 2000, 200);
+  put_aedat31_packet(data, 2, static_cast<std::int32_t>(kFrameEventSize), 0, 1, frame);
+  EXPECT_NE(error(data).find("a 200x48 frame does not fit its"), std::string::npos) << error(data);
+  data.clear();
+  frame.clear();
+  put_aedat31_frame(frame, kFrameEventSize, square(4), true, 1, 1000, 2000);
+  put_aedat31_packet(data, 2, static_cast<std::int32_t>(kFrameEventSize), 0, 1, frame);
+  data.resize(data.size() - 100);
+  EXPECT_NE(error(data).find("does not fit in the file (a recording cut short)"), std::string::npos) << error(data);
+  data.clear();
+  frame.clear();
+  put_aedat31_frame(frame, kFrameEventSize, cv::Mat(24, 32, CV_8UC1, cv::Scalar(9)), true, 1, 1000, 2000);
+  put_aedat31_packet(data, 2, static_cast<std::int32_t>(kFrameEventSize), 0, 1, frame);
+  EXPECT_NE(error(data).find("frame is 32x24, the sensor 64x48"), std::string::npos) << error(data);
+  write_bytes(path, "#!AER-DAT9.9\r\n", {});
+  EXPECT_THROW(open_frames(path, "", kSensor), FrameError);
+}
+
+/// jAER's DAVIS APS samples of one pixel (image coordinates: jAER mirrors both axes).
+void put_aps_sample(std::vector<std::uint8_t>& out, int x, int y, std::uint32_t read, std::uint32_t value, std::uint32_t t, int side) {
+  put_be32(out, 0x80000000u | static_cast<std::uint32_t>(side - 1 - y) << 22 | static_cast<std::uint32_t>(side - 1 - x) << 12 | read << 10 | value);
+  put_be32(out, t);
+}
+
+TEST_F(FramesTest, Aedat2DavisApsFramesAreResetMinusSignal) {
+  std::filesystem::create_directories(folder_);
+  constexpr int kSide = 128;  // a DAVIS128
+  const SensorSize sensor{kSide, kSide};
+  cv::Mat scene(kSide, kSide, CV_8UC1, cv::Scalar(40));
+  cv::rectangle(scene, cv::Rect(30, 50, 40, 20), cv::Scalar(200), cv::FILLED);
+  std::vector<std::uint8_t> data;
+  put_be32(data, 5u << 12 | 7u << 22 | 0x800u);  // a polarity event
+  put_be32(data, 10);
+  // A frame the recording starts inside: signal reads only, then resets of a tenth of the pixels.
+  for (int x = 0; x < 10; ++x) put_aps_sample(data, x, 0, 1, 100, 20, kSide);
+  for (int p = 0; p < kSide * kSide / 10; ++p) put_aps_sample(data, p % kSide, p / kSide, 0, 1023, 30, kSide);
+  std::uint32_t t = 1000;
+  std::vector<Timestamp> expected_times;
+  for (int frame = 0; frame < 2; ++frame) {
+    const std::uint32_t last_reset = t + kSide * kSide / 1000, first_signal = t + 5000;
+    for (int p = 0; p < kSide * kSide; ++p) put_aps_sample(data, p % kSide, p / kSide, 0, 1023, t + static_cast<std::uint32_t>(p / 1000), kSide);
+    put_be32(data, 0x80000C00u);  // an IMU sample
+    put_be32(data, t + 20);
+    for (int p = 0; p < kSide * kSide; ++p) {
+      const std::uint32_t light = 4u * scene.at<std::uint8_t>(p / kSide, (p % kSide + 3 * frame) % kSide);
+      put_aps_sample(data, p % kSide, p / kSide, 1, 1023 - light, first_signal + static_cast<std::uint32_t>(p / 1000), kSide);
+    }
+    expected_times.push_back(last_reset + (first_signal - last_reset) / 2);
+    t += 40000;
+  }
+  const auto path = folder_ / "davis128.aedat";
+  write_bytes(path, "#!AER-DAT2.0\r\n# AEChip: eu.seebetter.ini.chips.davis.DAVIS128\r\n#End Of ASCII Header\r\n", data);
+  const auto reader = open_frames(path, "", sensor);
+  for (int frame = 0; frame < 2; ++frame) {
+    const auto read = reader->next();
+    ASSERT_TRUE(read);
+    EXPECT_EQ(read->t_us, expected_times[static_cast<std::size_t>(frame)]);
+    cv::Mat shifted(kSide, kSide, CV_8UC1);
+    for (int y = 0; y < kSide; ++y) {
+      for (int x = 0; x < kSide; ++x) shifted.at<std::uint8_t>(y, x) = scene.at<std::uint8_t>(y, (x + 3 * frame) % kSide);
+    }
+    EXPECT_EQ(cv::norm(read->image, shifted, cv::NORM_INF), 0.0) << read->name;
+    EXPECT_NE(read->name.find("davis128.aedat: APS frame " + std::to_string(frame)), std::string::npos) << read->name;
+  }
+  EXPECT_FALSE(reader->next());
+
+  write_bytes(path, "#!AER-DAT2.0\r\n# AEChip: ch.unizh.ini.jaer.chip.retina.DVS128\r\n", {});
+  try {
+    open_frames(path, "", sensor);
+    ADD_FAILURE() << "a DVS128 recording gave frames";
+  } catch (const FrameError& e) {
+    EXPECT_NE(std::string(e.what()).find("DVS128 recording (its chip has no APS frames)"), std::string::npos) << e.what();
+  }
+}
+
+// ---- AEDAT 4.0 frame streams ----------------------------------------------------------------------
+
+/// A frame as DV writes one per FRME packet: built by slot number (as DV's own accessors read them:
+/// timestamp 4, start / end of exposure 10 / 12, format 14, sizeX 16, sizeY 18, pixels 24), not
+/// through evldt's schema, so a slot evldt's schema put elsewhere would fail here.
+std::vector<std::uint8_t> dv_frame(Timestamp t, Timestamp start_exposure, Timestamp end_exposure, std::int8_t format, const cv::Mat& image,
+                                   std::size_t pixels_cut = 0) {
+  flatbuffers::FlatBufferBuilder builder;
+  const cv::Mat continuous = image.clone();
+  const auto pixels = builder.CreateVector(continuous.data, continuous.total() * continuous.elemSize() - pixels_cut);
+  const auto start = builder.StartTable();
+  builder.AddElement<std::int64_t>(4, t, 0);
+  builder.AddElement<std::int64_t>(10, start_exposure, 0);
+  builder.AddElement<std::int64_t>(12, end_exposure, 0);
+  builder.AddElement<std::int8_t>(14, format, 0);
+  builder.AddElement<std::int16_t>(16, static_cast<std::int16_t>(image.cols), 0);
+  builder.AddElement<std::int16_t>(18, static_cast<std::int16_t>(image.rows), 0);
+  builder.AddOffset(24, pixels);
+  builder.FinishSizePrefixed(flatbuffers::Offset<void>(builder.EndTable(start)), "FRME");
+  return {builder.GetBufferPointer(), builder.GetBufferPointer() + builder.GetSize()};
+}
+
+/// An AEDAT 4.0 file (uncompressed) of an event stream (0) and, unless `frames_stream` is false, a
+/// frame stream (2), each payload a packet of the stream given.
+void write_aedat4(const std::filesystem::path& path, const std::vector<std::pair<int, std::vector<std::uint8_t>>>& packets,
+                  bool frames_stream = true) {
+  const std::string info = std::string(R"(<dv version="2.0"><node name="outInfo" path="/mainloop/Recorder/outInfo/">)") +
+                           R"(<node name="0" path="/mainloop/Recorder/outInfo/0/"><attr key="typeIdentifier" type="string">EVTS</attr></node>)" +
+                           (frames_stream ? R"(<node name="2" path="/mainloop/Recorder/outInfo/2/"><attr key="typeIdentifier" type="string">FRME</attr></node>)" : "") +
+                           "</node></dv>";
+  flatbuffers::FlatBufferBuilder header;
+  aedat4::FinishSizePrefixedIOHeaderBuffer(header, aedat4::CreateIOHeaderDirect(header, aedat4::CompressionType::NONE, -1, info.c_str()));
+  std::vector<std::uint8_t> data(header.GetBufferPointer(), header.GetBufferPointer() + header.GetSize());
+  for (const auto& [stream, payload] : packets) {
+    put32(data, static_cast<std::uint32_t>(stream));
+    put32(data, static_cast<std::uint32_t>(payload.size()));
+    data.insert(data.end(), payload.begin(), payload.end());
+  }
+  write_bytes(path, "#!AER-DAT4.0\r\n", data);
+}
+
+TEST_F(FramesTest, Aedat4FrameStreamsReadGreyAndColourAtTheMiddleOfTheirExposure) {
+  std::filesystem::create_directories(folder_);
+  const auto path = folder_ / "dv.aedat4";
+  cv::Mat colour_grey;
+  cv::cvtColor(coloured_square(16), colour_grey, cv::COLOR_BGR2GRAY);
+  write_aedat4(path, {{0, std::vector<std::uint8_t>(40, 3)},  // events: passed over
+                      {2, dv_frame(1'000'000, 1'000'000, 1'004'000, 0, square(4))},
+                      {0, std::vector<std::uint8_t>(40, 3)},
+                      {2, dv_frame(1'040'000, 1'040'000, 1'041'000, 16, coloured_square(16))},
+                      {2, dv_frame(1'080'000, 0, 0, 0, square(28))}});  // no exposure given: its time stamp
+  const auto reader = open_frames(path, "", kSensor);
+  for (const auto& [t, expected] : {std::pair{Timestamp{1'002'000}, square(4)}, std::pair{Timestamp{1'040'500}, colour_grey},
+                                    std::pair{Timestamp{1'080'000}, square(28)}}) {
+    const auto frame = reader->next();
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->t_us, t);
+    EXPECT_EQ(cv::norm(frame->image, expected, cv::NORM_INF), 0.0) << frame->name;
+    EXPECT_NE(frame->name.find("dv.aedat4: frame packet at byte "), std::string::npos) << frame->name;
+  }
+  EXPECT_FALSE(reader->next());
+}
+
+TEST_F(FramesTest, Aedat4BadFramesNameTheFrame) {
+  std::filesystem::create_directories(folder_);
+  const auto path = folder_ / "bad.aedat4";
+  const auto error = [&] {
+    try {
+      const auto reader = open_frames(path, "", kSensor);
+      while (reader->next()) {
+      }
+    } catch (const FrameError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  cv::Mat bgra;
+  cv::cvtColor(coloured_square(4), bgra, cv::COLOR_BGR2BGRA);
+  write_aedat4(path, {{2, dv_frame(1000, 0, 0, 24, bgra)}});
+  EXPECT_NE(error().find("pixel format 24 is not one evldt reads"), std::string::npos) << error();
+  write_aedat4(path, {{2, dv_frame(1000, 0, 0, 0, square(4), 10)}});
+  EXPECT_NE(error().find("3062 bytes of pixels for a 64x48 frame"), std::string::npos) << error();
+  write_aedat4(path, {{2, std::vector<std::uint8_t>(64, 0xAB)}});
+  EXPECT_NE(error().find("not a valid Frame FlatBuffer"), std::string::npos) << error();
+  write_aedat4(path, {}, false);
+  EXPECT_NE(error().find("bad.aedat4: no frame stream (FRME) in the header"), std::string::npos) << error();
 }
 
 // A video's frames on the clock --from-video emulates its events on (frame k at k / fps s).

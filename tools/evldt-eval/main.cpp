@@ -429,8 +429,8 @@ int main(int argc, char** argv) {
   app.add_option("--ground-truth", options.ground_truth, "Ground-truth CSV (from evldt-sim)")->check(CLI::ExistingFile);
   app.add_option("--frames-gt", options.frames_gt,
                  "Ground truth as the paper makes it: LSD on the intensity frames of this ECD folder (images.txt and "
-                 "images/; evldt-sim --frames-hz writes one), ROS 1 or 2 bag (.bag, .db3, .mcap) (sensor_msgs/Image: mono8, mono16, bgr8, rgb8) or "
-                 "MVSEC HDF5 file, in place of the exact lines")
+                 "images/; evldt-sim --frames-hz writes one), ROS 1 or 2 bag (.bag, .db3, .mcap) (sensor_msgs/Image: mono8, mono16, bgr8, rgb8), "
+                 "MVSEC HDF5 file, AEDAT 4.0, 3.1 or 2.0 (jAER DAVIS) recording or video file, in place of the exact lines")
       ->check(CLI::ExistingPath);
   app.add_option("--frames-topic", options.frames_topic,
                  "With --frames-gt a bag: its image topic (default: the first sensor_msgs/Image); an HDF5 file: its frame "

@@ -1,4 +1,5 @@
-// Frames from containers that hold images beside events (ROS 1 and 2 bags, MCAP, MVSEC's HDF5): each image,
+// Frames from containers that hold images beside events (ROS 1 and 2 bags, MCAP, MVSEC's HDF5, AEDAT
+// 4.0, 3.1 and 2.0): each image,
 // through the conversion its pixel encoding names, to the 8-bit grey frame LSD runs on.
 
 
@@ -96,7 +97,7 @@ std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, cons
   if (images) return std::make_unique<ImageFrameReader>(std::move(images), sensor);
   if (auto video = open_video_frames(path, sensor)) return video;
   throw FrameError(path.string() + ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 or 2 bag or MCAP "
-                   "file, MVSEC's HDF5, a video file)");
+                   "file, MVSEC's HDF5, an AEDAT 4.0, 3.1 or 2.0 recording, a video file)");
 }
 
 }  // namespace evldt

@@ -37,7 +37,8 @@ class ImageSource {
 
 /// The images of the container `path` holds, recognised by its first bytes: a ROS 1 bag's, ROS 2
 /// bag's (.db3) or MCAP file's image topic `stream` (empty: the first), an HDF5 file's frames `stream` (empty: MVSEC's
-/// /davis/left/image_raw); nullptr for a file that is none of them. Throws std::runtime_error naming
+/// /davis/left/image_raw), an AEDAT 4.0 file's first frame stream, AEDAT 3.1 frame packets, jAER's
+/// AEDAT 2.0 DAVIS APS samples; nullptr for a file that is none of them. Throws std::runtime_error naming
 /// the file for a container without such images.
 std::unique_ptr<ImageSource> open_image_container(const std::filesystem::path& path, const std::string& stream);
 

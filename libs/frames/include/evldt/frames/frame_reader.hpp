@@ -2,7 +2,7 @@
 // Intensity frames a recording holds beside its events (a DAVIS's APS frames, a simulator's
 // renderings), pixel-aligned with the events: the ground truth the paper draws lines from (issue 28).
 // A reader per container, behind one interface, as the event readers are: the Event Camera
-// Dataset's folder layout; sensor_msgs/Image in ROS 1 and 2 bags (.db3, MCAP) and MVSEC's HDF5
+// Dataset's folder layout; sensor_msgs/Image in ROS 1 and 2 bags (.db3, MCAP), MVSEC's HDF5 and AEDAT
 // frames, whose containers (libs/containers) yield images that are converted here by their pixel
 // encoding; video files, whose frames are those events are emulated from (--from-video).
 
@@ -52,7 +52,9 @@ Timestamp video_frame_time_us(std::uint64_t index, double fps);
 /// The frames of `path`, whichever container it is: an ECD folder (or its images.txt); a ROS 1 or
 /// ROS 2 bag's (.db3 or MCAP) sensor_msgs/Image topic `stream` (empty: the first; pixel encodings
 /// mono8, mono16 (its high byte), bgr8 and rgb8, as grey); MVSEC's HDF5 frames `stream` (empty:
-/// /davis/left/image_raw, with its _ts times); else a video file OpenCV opens (as grey, at its
+/// /davis/left/image_raw, with its _ts times); the frames of an AEDAT 4.0 recording's first frame
+/// stream, of AEDAT 3.1 frame packets, of jAER's AEDAT 2.0 DAVIS APS samples (reset - signal), each at
+/// the middle of its exposure (libs/containers: aedat4.hpp, aedat_images.hpp); else a video file OpenCV opens (as grey, at its
 /// frame rate, else 30 fps, as --from-video emulates events from it). Throws FrameError naming the
 /// path for anything else or a container without them.
 std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream, SensorSize sensor);
