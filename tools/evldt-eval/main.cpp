@@ -153,7 +153,10 @@ std::string figure(double value, int decimals = 3) {
 
 void print_table(const std::vector<Report>& reports, const Options& options) {
   std::printf("%-24s %6s", "run", "f_th");
-  for (const double tol : options.tolerances) std::printf("   P@%.0f%%   R@%.0f%%   F@%.0f%%", tol * 100, tol * 100, tol * 100);
+  for (const double tol : options.tolerances) {
+    const std::string at = fmt::format("@{:g}%", tol * 100);  // 1%, 0.2%
+    std::printf("  %6s  %6s  %6s", ("P" + at).c_str(), ("R" + at).c_str(), ("F" + at).c_str());
+  }
   std::printf("  segs/step  gt/step  gt_steps  no_pred  ids  life_mean_ms life_max_ms  cover  ids/gt  id_sw   IDF1\n");
   for (const Report& r : reports) {
     if (r.threshold) {
