@@ -610,6 +610,18 @@ TEST_F(FramesTest, Aedat4BadFramesNameTheFrame) {
   EXPECT_NE(error().find("bad.aedat4: no frame stream (FRME) in the header"), std::string::npos) << error();
 }
 
+// A real DVXplorer recording has events only: asked for frames, it is refused by name.
+TEST_F(FramesTest, Aedat4RecordingWithoutFramesIsRefusedByName) {
+  const std::filesystem::path recording = std::filesystem::path(EVLDT_SHARED_DIR) / "real" / "dvxplorer_person.aedat4";
+  if (!std::filesystem::exists(recording)) GTEST_SKIP() << "no real recordings at " << recording.parent_path() << " (../shared is absent)";
+  try {
+    open_frames(recording, "", {320, 240});
+    ADD_FAILURE() << "a recording without frames gave a frame reader";
+  } catch (const FrameError& e) {
+    EXPECT_NE(std::string(e.what()).find("dvxplorer_person.aedat4: no frame stream (FRME) in the header"), std::string::npos) << e.what();
+  }
+}
+
 // A video's frames on the clock --from-video emulates its events on (frame k at k / fps s).
 TEST_F(FramesTest, VideoFramesOnTheClockOfTheEventsEmulatedFromThem) {
   std::filesystem::create_directories(folder_);
