@@ -143,8 +143,8 @@ def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), out
 def read_frames(path, width, height, topic=""):
     """The intensity frames of a folder in the Event Camera Dataset's layout (images.txt and images/;
     evldt-sim --frames-hz writes one), of a ROS 1 or 2 bag's (.bag, .db3, .mcap) sensor_msgs/Image topic (mono8, mono16, bgr8
-    or rgb8, read as grey) or of an HDF5 file in MVSEC's layout (/davis/left/image_raw and its _ts
-    times); ``topic`` picks the bag's topic or the HDF5 dataset (empty: the first / the left camera).
+    or rgb8, read as grey), of an HDF5 file in MVSEC's layout (/davis/left/image_raw and its _ts
+    times), of an AEDAT 4.0, 3.1 or jAER 2.0 DAVIS recording, or of a video file; ``topic`` picks the bag's topic or the HDF5 dataset (empty: the first / the left camera).
     A list of (t_us, image), image a height x width uint8 array, in time order. A frame that is
     missing, unreadable, of another size, of another pixel encoding or out of time order raises
     FrameError (a ValueError) naming it."""
