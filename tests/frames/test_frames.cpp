@@ -50,6 +50,17 @@ class FramesTest : public ::testing::Test {
     return image;
   }
   void write_list(const std::string& text) { std::ofstream(folder_ / "images.txt") << text; }
+  /// The FrameError of reading every frame of `path` (open_frames), or empty.
+  static std::string read_error(const std::filesystem::path& path, const std::string& stream = {}) {
+    try {
+      const auto reader = open_frames(path, stream, kSensor);
+      while (reader->next()) {
+      }
+    } catch (const FrameError& e) {
+      return e.what();
+    }
+    return "";
+  }
   std::string error_of(const std::filesystem::path& path) {
     try {
       const auto reader = open_ecd_frames(path, kSensor);
@@ -333,16 +344,7 @@ TEST_F(FramesTest, MvsecHdf5FramesOfEitherCameraReadWithTheirTimes) {
 TEST_F(FramesTest, MvsecHdf5BadInputsAreClearErrors) {
   std::filesystem::create_directories(folder_);
   const std::filesystem::path path = folder_ / "bad.hdf5";
-  const auto error = [&](const std::string& stream = {}) {
-    try {
-      const auto reader = open_frames(path, stream, kSensor);
-      while (reader->next()) {
-      }
-    } catch (const FrameError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  const auto error = [&](const std::string& stream = {}) { return read_error(path, stream); };
   write_mvsec_frames(path, {square(4), square(8)}, {1.0});
   EXPECT_NE(error().find("/davis/left/image_raw_ts holds 1 times for 2 frames"), std::string::npos) << error();
   write_mvsec_frames(path, {square(4)}, {1.0});
@@ -432,14 +434,7 @@ TEST_F(FramesTest, Aedat31BadFramesNameTheFrame) {
   const auto path = folder_ / "bad.aedat";
   const auto error = [&](const std::vector<std::uint8_t>& data) {
     write_bytes(path, kAedat31Header, data);
-    try {
-      const auto reader = open_frames(path, "", kSensor);
-      while (reader->next()) {
-      }
-    } catch (const FrameError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
+    return read_error(path);
   };
   std::vector<std::uint8_t> data, frame;
   put_aedat31_frame(frame, kFrameEventSize, square(4), true, 3, 1000, 2000);
@@ -588,16 +583,7 @@ TEST_F(FramesTest, Aedat4FrameStreamsReadGreyAndColourAtTheMiddleOfTheirExposure
 TEST_F(FramesTest, Aedat4BadFramesNameTheFrame) {
   std::filesystem::create_directories(folder_);
   const auto path = folder_ / "bad.aedat4";
-  const auto error = [&] {
-    try {
-      const auto reader = open_frames(path, "", kSensor);
-      while (reader->next()) {
-      }
-    } catch (const FrameError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  const auto error = [&] { return read_error(path); };
   cv::Mat bgra;
   cv::cvtColor(coloured_square(4), bgra, cv::COLOR_BGR2BGRA);
   write_aedat4(path, {{2, dv_frame(1000, 0, 0, 24, bgra)}});

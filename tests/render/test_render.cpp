@@ -1,9 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
 #include <vector>
+
+#include <opencv2/imgproc.hpp>
 
 #include "evldt/render/scene_renderer.hpp"
 #include "evldt/render/short_ids.hpp"
+#include "evldt/render/status_text.hpp"
 
 namespace evldt {
 namespace {
@@ -78,6 +83,34 @@ TEST(RenderScene, LayersAppearOnlyWhenSwitchedOn) {
   EXPECT_FALSE(black(pixel(canvas, 4, 2)));
   EXPECT_FALSE(black(pixel(canvas, 2, 12)));
   EXPECT_TRUE(black(pixel(canvas, 2, 2)));
+}
+
+// The viz's status fields at a 240x180 sensor drawn at scale 1: wrapped, every line fits the
+// picture (drawn on one twice as wide, no text reaches past its width), fields whole and in order.
+TEST(StatusText, FieldsWrapToThePictureWidthWholeAndInOrder) {
+  const std::vector<std::string> fields = {"cam0", "t=12.345 s", "1.23 Mev/s", "57 lines", "9 whole", "detect 100 Hz", "track 500 Hz",
+                                           "latency 3.2/7.0 ms", "lost 0", "shed 0", "hot pixels 3"};
+  for (const int width : {240, 346, 640, 1280}) {
+    const std::vector<std::string> lines = wrap_fields(fields, width);
+    std::vector<std::string> rejoined;
+    for (const std::string& line : lines) {
+      for (std::size_t start = 0; start <= line.size();) {
+        const std::size_t gap = std::min(line.find("  ", start), line.size());
+        rejoined.push_back(line.substr(start, gap - start));
+        start = gap + 2;
+      }
+    }
+    EXPECT_EQ(rejoined, fields) << width;
+    cv::Mat canvas(400, 2 * width, CV_8UC3, cv::Scalar(0, 0, 0));
+    EXPECT_EQ(put_text_lines(canvas, lines, 0), static_cast<int>(lines.size()));
+    cv::Mat beyond;
+    cv::cvtColor(canvas.colRange(width, 2 * width), beyond, cv::COLOR_BGR2GRAY);
+    EXPECT_EQ(cv::countNonZero(beyond), 0) << width << " px: a line runs past the picture";
+    if (width == 1280) EXPECT_EQ(lines.size(), 1u);
+    if (width == 240) EXPECT_GE(lines.size(), 4u);
+  }
+  const std::vector<std::string> wide = {"a field far wider than the narrow picture it is drawn on"};
+  EXPECT_EQ(wrap_fields(wide, 60), wide);  // never split
 }
 
 }  // namespace

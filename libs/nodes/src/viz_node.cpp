@@ -1,11 +1,13 @@
 #include "evldt/nodes/viz_node.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <chrono>
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
 
+#include "evldt/render/status_text.hpp"
 #include "evldt/transport/channels.hpp"
 
 namespace evldt {
@@ -15,10 +17,15 @@ std::span<const std::uint8_t> payload_of(const lcm::ReceiveBuffer* buffer) {
   return {static_cast<const std::uint8_t*>(buffer->data), buffer->data_size};
 }
 
-void put_line(cv::Mat& canvas, const std::string& text, int row) {
-  const cv::Point origin(6, 16 + 18 * row);
-  cv::putText(canvas, text, origin, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
-  cv::putText(canvas, text, origin, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+/// The fields of a text of items separated by ", " (kLayerKeys).
+std::vector<std::string> split_items(std::string_view text) {
+  std::vector<std::string> items;
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t comma = std::min(text.find(", ", start), text.size());
+    items.emplace_back(text.substr(start, comma - start));
+    start = comma + 2;
+  }
+  return items;
 }
 
 }  // namespace
@@ -49,6 +56,7 @@ void VizNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
     const LatticeParams params = default_config_for(*receiver_.sensor()).lattice;
     lattice_.emplace(params.sensor, params.block_size, params.alpha, /*keep_surface=*/true);
   }
+  if (!first_event_us_ || receiver_.restarted()) first_event_us_ = batch_.empty() ? std::optional<Timestamp>() : batch_.t.front();
   for (std::size_t i = 0; i < batch_.size(); ++i) lattice_->insert(batch_.x[i], batch_.y[i]);
   events_since_frame_ += batch_.size();
 }
@@ -100,30 +108,32 @@ void VizNode::render(cv::Mat& canvas) {
     short_whole_ids_.label(ids_, labels_);
     draw_whole_lines(whole_lines_, render, canvas, labels_);
   }
+  // Each group of fields wraps to the picture's width; time is since the first event seen (a real
+  // recording's clock is its epoch).
   const ReceiverCounts counts = receiver_.counts();
-  put_line(canvas,
-           fmt::format("{}  t={:.3f}s  {:.2f} Mev/s  {} lines", options_.camera, static_cast<double>(lines_t_us_) * 1e-6,
-                       event_rate_ * 1e-6, lines_.size()),
-           0);
+  const double since_first_s = first_event_us_ ? static_cast<double>(lines_t_us_ - *first_event_us_) * 1e-6 : 0.0;
+  const auto put = [&](const std::vector<std::string>& fields, int row) { return put_text_lines(canvas, wrap_fields(fields, canvas.cols), row); };
+  int row = put({options_.camera, fmt::format("t={:.3f} s", std::max(0.0, since_first_s)), fmt::format("{:.2f} Mev/s", event_rate_ * 1e-6),
+                 fmt::format("{} lines", lines_.size()), fmt::format("{} whole", whole_lines_.size())},
+                0);
   if (stats_) {
     draw_masked_pixels(sensor, stats_->masked_pixels, options_.render.scale, canvas);
-    put_line(canvas,
-             fmt::format("detect {:.0f} Hz  track {:.0f} Hz  latency {:.1f}/{:.1f} ms  lost {}  shed {}  hot pixels {}",
-                         stats_->detect_hz, stats_->track_hz, stats_->latency_median_ms, stats_->latency_p99_ms,
-                         stats_->batches_lost, stats_->batches_shed, stats_->num_masked_pixels),
-             1);
+    row = put({fmt::format("detect {:.0f} Hz", stats_->detect_hz), fmt::format("track {:.0f} Hz", stats_->track_hz),
+               fmt::format("latency {:.1f}/{:.1f} ms", stats_->latency_median_ms, stats_->latency_p99_ms),
+               fmt::format("lost {}", stats_->batches_lost), fmt::format("shed {}", stats_->batches_shed),
+               fmt::format("hot pixels {}", stats_->num_masked_pixels)},
+              row);
   } else {
-    put_line(canvas, "no statistics from evldt-lines yet", 1);
+    row = put({"no statistics from evldt-lines yet"}, row);
   }
-  int row = 2;
   if (camera_stats_ && camera_stats_->sensor_lag_samples > 0) {
-    put_line(canvas, fmt::format("camera: sensor lag {:.1f}/{:.1f} ms", camera_stats_->sensor_lag_median_ms, camera_stats_->sensor_lag_p99_ms),
-             row++);
+    row = put({fmt::format("camera: sensor lag {:.1f}/{:.1f} ms", camera_stats_->sensor_lag_median_ms, camera_stats_->sensor_lag_p99_ms)},
+              row);
   }
   if (counts.sequence.lost || counts.invalid_messages) {
-    put_line(canvas, fmt::format("viz: {} batches lost, {} invalid", counts.sequence.lost, counts.invalid_messages), row++);
+    row = put({fmt::format("viz: {} batches lost", counts.sequence.lost), fmt::format("{} invalid", counts.invalid_messages)}, row);
   }
-  if (options_.show_key_help) put_line(canvas, kLayerKeys, row);
+  if (options_.show_key_help) put(split_items(kLayerKeys), row);
 }
 
 bool VizNode::handle_pending(Clock::time_point deadline) {

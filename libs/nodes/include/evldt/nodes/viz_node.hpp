@@ -87,6 +87,7 @@ class VizNode {
   std::vector<std::uint64_t> ids_;
   std::vector<std::uint32_t> labels_;
   Timestamp lines_t_us_ = 0;
+  std::optional<Timestamp> first_event_us_;  ///< of the stream (since its last restart), for the time shown
   stats_t stats_msg_;
   std::optional<stats_t> stats_;
   std::optional<stats_t> camera_stats_;  ///< our camera service's, for a live source's lag
