@@ -493,7 +493,8 @@ TEST_F(FramesTest, Aedat2DavisApsFramesAreResetMinusSignal) {
     t += 40000;
   }
   const auto path = folder_ / "davis128.aedat";
-  write_bytes(path, "#!AER-DAT2.0\r\n# AEChip: eu.seebetter.ini.chips.davis.DAVIS128\r\n#End Of ASCII Header\r\n", data);
+  // No "#End Of ASCII Header" line (older jAER files): the header ends where the data begins.
+  write_bytes(path, "#!AER-DAT2.0\r\n# AEChip: eu.seebetter.ini.chips.davis.DAVIS128\r\n", data);
   const auto reader = open_frames(path, "", sensor);
   for (int frame = 0; frame < 2; ++frame) {
     const auto read = reader->next();

@@ -132,11 +132,13 @@ class Aedat2Images final : public ImageSource {
     if (chip == header.lines().end() || chip->find("DVS128") != std::string::npos) {
       throw std::runtime_error(path_ + ": a DVS128 recording (its chip has no APS frames)");
     }
-    // The chip's size as the event decoder reads it from the header.
+    // The chip's size as the event decoder reads it from the header, and the first records after it
+    // (a header without jAER's end line ends only where the data begins).
     auto decoder = detail::make_aedat2_decoder(path_);
     std::ifstream bytes(path, std::ios::binary);
-    std::vector<std::uint8_t> start(header.size());
+    std::vector<std::uint8_t> start(header.size() + 4096);
     bytes.read(reinterpret_cast<char*>(start.data()), static_cast<std::streamsize>(start.size()));
+    start.resize(static_cast<std::size_t>(bytes.gcount()));
     EventBatch none;
     decoder->decode(start, none);
     if (!decoder->geometry()) throw std::runtime_error(path_ + ": the header names no chip of known size");
