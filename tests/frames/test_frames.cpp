@@ -182,16 +182,6 @@ class BagFramesTest : public FramesTest {
     bag.close();
     return path;
   }
-  std::string bag_error(const std::filesystem::path& path, const std::string& topic = {}) {
-    try {
-      const auto reader = open_frames(path, topic, kSensor);
-      while (reader->next()) {
-      }
-    } catch (const FrameError& e) {
-      return e.what();
-    }
-    return "";
-  }
 };
 
 // A red square on blue: bgr8 and rgb8 read in the wrong channel order would weigh them otherwise.
@@ -230,21 +220,21 @@ TEST_F(BagFramesTest, EveryPixelEncodingReadsAsTheGreyItHolds) {
 TEST_F(BagFramesTest, BadInputsNameTheFrame) {
   const Timestamp t0 = 1'700'000'000'000'000;
   const auto nth = [](const std::string& error) { return error.find("message 1 of /dvs/image_raw") != std::string::npos; };
-  std::string error = bag_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "bayer_rggb8")}));
+  std::string error = read_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "bayer_rggb8")}));
   EXPECT_TRUE(nth(error) && error.find("pixel encoding 'bayer_rggb8'") != std::string::npos) << error;
-  error = bag_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)), "mono8")}));
+  error = read_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)), "mono8")}));
   EXPECT_TRUE(nth(error) && error.find("frame is 10x10, the sensor 64x48") != std::string::npos) << error;
-  error = bag_error(write_bag({ros_image(t0 + 10, square(8), "mono8"), ros_image(t0, square(8), "mono8")}));
+  error = read_error(write_bag({ros_image(t0 + 10, square(8), "mono8"), ros_image(t0, square(8), "mono8")}));
   EXPECT_TRUE(nth(error) && error.find("earlier than the one before") != std::string::npos) << error;
-  error = bag_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "mono16", false, 0, 7)}));
+  error = read_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "mono16", false, 0, 7)}));
   EXPECT_TRUE(nth(error) && error.find("holds only") != std::string::npos) << error;
   const std::filesystem::path good = write_bag({ros_image(t0, square(8), "mono8")});
-  error = bag_error(good, "/imu");
+  error = read_error(good, "/imu");
   EXPECT_NE(error.find("topic /imu is of type sensor_msgs/Imu, not sensor_msgs/Image"), std::string::npos) << error;
-  error = bag_error(good, "/none");
+  error = read_error(good, "/none");
   EXPECT_NE(error.find("no topic /none (topics: "), std::string::npos) << error;
   std::ofstream(folder_ / "junk.bin") << "not frames";
-  error = bag_error(folder_ / "junk.bin");
+  error = read_error(folder_ / "junk.bin");
   EXPECT_NE(error.find("not a source of frames"), std::string::npos) << error;
   // Nothing is scored from a bag whose frames throw.
   const auto reader = open_frames(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "yuv422")}), "", kSensor);
