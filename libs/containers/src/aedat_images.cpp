@@ -118,11 +118,6 @@ class Aedat31Images final : public ImageSource {
   std::size_t event_size_ = 0, events_ = 0, next_event_ = 0;
 };
 
-std::uint32_t load_be32(const std::uint8_t* bytes) {
-  return static_cast<std::uint32_t>(bytes[0]) << 24 | static_cast<std::uint32_t>(bytes[1]) << 16 |
-         static_cast<std::uint32_t>(bytes[2]) << 8 | bytes[3];
-}
-
 class Aedat2Images final : public ImageSource {
  public:
   explicit Aedat2Images(const std::filesystem::path& path) : file_(path, "AEDAT 2.0"), path_(path.string()) {
@@ -160,7 +155,7 @@ class Aedat2Images final : public ImageSource {
   bool next(RecordingImage& image, std::string& location) override {
     std::uint8_t record[8];
     while (file_.read_exactly_or_end(record, sizeof record, "an 8-byte AEDAT 2.0 event")) {
-      const std::uint32_t address = load_be32(record), time = load_be32(record + 4);
+      const std::uint32_t address = detail::load_be32(record), time = detail::load_be32(record + 4);
       if (last_time_ >= time + (std::uint64_t{1} << 31)) wraps_ += 1;
       last_time_ = time;
       if ((address & 0x80000000u) == 0) continue;  // a polarity event

@@ -204,11 +204,6 @@ class Aedat31Decoder final : public EventDecoder {
   DecodeCounts counts_;
 };
 
-std::uint32_t load_be32(const std::uint8_t* bytes) {
-  return static_cast<std::uint32_t>(bytes[0]) << 24 | static_cast<std::uint32_t>(bytes[1]) << 16 |
-         static_cast<std::uint32_t>(bytes[2]) << 8 | bytes[3];
-}
-
 class Aedat2Decoder final : public EventDecoder {
  public:
   explicit Aedat2Decoder(std::string source) : source_(std::move(source)), header_('#') {}

@@ -161,6 +161,12 @@ inline std::uint32_t load_le32(const std::uint8_t* bytes) {
          (static_cast<std::uint32_t>(bytes[2]) << 16) | (static_cast<std::uint32_t>(bytes[3]) << 24);
 }
 
+/// Big-endian, as jAER's AEDAT 2.0 writes its addresses and times.
+inline std::uint32_t load_be32(const std::uint8_t* bytes) {
+  return static_cast<std::uint32_t>(bytes[0]) << 24 | static_cast<std::uint32_t>(bytes[1]) << 16 |
+         static_cast<std::uint32_t>(bytes[2]) << 8 | bytes[3];
+}
+
 inline std::uint64_t load_le64(const std::uint8_t* bytes) {
   return static_cast<std::uint64_t>(load_le32(bytes)) | (static_cast<std::uint64_t>(load_le32(bytes + 4)) << 32);
 }
