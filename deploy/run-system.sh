@@ -51,7 +51,7 @@ nice -n -10 lcm-logger --lcm-url="$logger_url" -f -q "$out/run.lcmlog" &
 pids+=($!)
 "$bin/services/evldt-lines/evldt-lines" --camera "$camera_name" >"$out/lines.txt" 2>"$out/lines.log" &
 pids+=($!)
-viz_args=(--camera "$camera_name" --show-ids --png-dir "$out/png" --png-period-s 1)
+viz_args=(--camera "$camera_name" --png-dir "$out/png" --png-period-s 1)
 ((window)) || viz_args+=(--headless --video "$out/viz.mp4")
 "$bin/services/evldt-viz/evldt-viz" "${viz_args[@]}" >"$out/viz.txt" 2>"$out/viz.log" &
 pids+=($!)

@@ -9,8 +9,8 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 # What the tests need beyond the product: clang and libFuzzer for the fuzz targets, iproute2 for
-# the multi-host test's network namespaces.
-deploy/install-deps.sh clang libclang-rt-14-dev iproute2
+# the multi-host test's network namespaces, Chromium for the web view's browser test.
+deploy/install-deps.sh clang libclang-rt-14-dev iproute2 chromium
 source tests/suites.sh
 started=$SECONDS
 

@@ -33,20 +33,30 @@ TEST(ShortIds, NumbersIdsInOrderOfFirstAppearanceAndKeepsThemWhileSeen) {
 
 TEST(ToggleLayer, EachKeyFlipsItsLayerAndOtherKeysNothing) {
   RenderOptions options;
-  EXPECT_TRUE(toggle_layer(options, 'e'));
-  EXPECT_FALSE(options.show_events);
-  EXPECT_TRUE(toggle_layer(options, 's'));
-  EXPECT_FALSE(options.show_segments);
-  EXPECT_TRUE(toggle_layer(options, 'b'));
-  EXPECT_FALSE(options.show_bad_tracks);
-  EXPECT_TRUE(toggle_layer(options, 'g'));
-  EXPECT_TRUE(options.show_grid);
-  EXPECT_TRUE(toggle_layer(options, 'i'));
-  EXPECT_TRUE(options.show_ids);
+  // By default: whole lines with their ids over segments without theirs, no grid.
+  EXPECT_TRUE(options.show_whole_lines && options.show_whole_line_ids && options.show_segments && !options.show_segment_ids);
+  EXPECT_FALSE(options.show_grid);
+  const std::vector<std::pair<int, bool RenderOptions::*>> keys = {
+      {'e', &RenderOptions::show_events},      {'s', &RenderOptions::show_segments},
+      {'b', &RenderOptions::show_bad_tracks},  {'w', &RenderOptions::show_whole_lines},
+      {'i', &RenderOptions::show_whole_line_ids}, {'n', &RenderOptions::show_segment_ids},
+      {'g', &RenderOptions::show_grid}};
+  for (const auto& [key, shown] : keys) {
+    const RenderOptions before = options;
+    EXPECT_TRUE(toggle_layer(options, key)) << static_cast<char>(key);
+    EXPECT_NE(options.*shown, before.*shown) << static_cast<char>(key);
+    for (const auto& [other_key, other] : keys) {
+      if (other_key != key) {
+        EXPECT_EQ(options.*other, before.*other) << static_cast<char>(key) << " changed " << static_cast<char>(other_key);
+      }
+    }
+  }
   const RenderOptions before = options;
   EXPECT_FALSE(toggle_layer(options, 'x'));
   EXPECT_FALSE(toggle_layer(options, -1));  // no key pressed
-  EXPECT_EQ(options.show_events, before.show_events);
+  for (const auto& [key, shown] : keys) EXPECT_EQ(options.*shown, before.*shown);
+  EXPECT_EQ(layer_key_help(), (std::vector<std::string>{"keys: e events", "s segments", "b bad tracks", "w whole lines", "i whole-line ids",
+                                                        "n segment ids", "g block grid", "q quit"}));
 }
 
 constexpr SensorSize kSensor{40, 30};
@@ -106,8 +116,12 @@ TEST(StatusText, FieldsWrapToThePictureWidthWholeAndInOrder) {
     cv::Mat beyond;
     cv::cvtColor(canvas.colRange(width, 2 * width), beyond, cv::COLOR_BGR2GRAY);
     EXPECT_EQ(cv::countNonZero(beyond), 0) << width << " px: a line runs past the picture";
-    if (width == 1280) EXPECT_EQ(lines.size(), 1u);
-    if (width == 240) EXPECT_GE(lines.size(), 4u);
+    if (width == 1280) {
+      EXPECT_EQ(lines.size(), 1u);
+    }
+    if (width == 240) {
+      EXPECT_GE(lines.size(), 4u);
+    }
   }
   const std::vector<std::string> wide = {"a field far wider than the narrow picture it is drawn on"};
   EXPECT_EQ(wrap_fields(wide, 60), wide);  // never split

@@ -16,7 +16,7 @@
 #include "evldt/lines/segment_csv.hpp"
 #include "evldt/lines/whole_lines.hpp"
 #include "evldt/render/frame_writer.hpp"
-#include "evldt/render/scene_renderer.hpp"
+#include "evldt/render/line_picture.hpp"
 
 namespace {
 
@@ -31,8 +31,7 @@ struct Options {
   std::filesystem::path video;
   std::filesystem::path frames_dir;
   Timestamp render_period_us = 33333;
-  int render_scale = 2;
-  bool show_ids = false;
+  RenderOptions render{.scale = 2};
   bool quiet = false;
 };
 
@@ -42,15 +41,17 @@ class FrameSink {
   FrameSink(const Options& options, SensorSize sensor)
       : period_us_(options.render_period_us),
         sensor_(sensor),
-        render_{.scale = options.render_scale, .show_ids = options.show_ids},
+        render_(options.render),
         writer_(options.video, options.frames_dir, 1e6 / static_cast<double>(options.render_period_us),
-                cv::Size(sensor.width * options.render_scale, sensor.height * options.render_scale)) {}
+                cv::Size(sensor.width * options.render.scale, sensor.height * options.render.scale)) {}
   [[nodiscard]] bool enabled() const { return writer_.enabled(); }
+  /// Whether the frames need the whole lines.
+  [[nodiscard]] bool draws_whole_lines() const { return enabled() && render_.show_whole_lines; }
 
-  void step(Timestamp t, const LineMap& lines, const ScarfLattice& lattice) {
+  void step(Timestamp t, const LineMap& lines, std::span<const TrackedLine> whole_lines, const ScarfLattice& lattice) {
     if (!enabled() || t < next_render_) return;
     next_render_ = t + period_us_;
-    render_scene(sensor_, lattice.surface(), lines.lines(), render_, canvas_);
+    picture_.draw(sensor_, lattice.surface(), lines.lines(), whole_lines, render_, canvas_);
     writer_.write(canvas_);
   }
   [[nodiscard]] int frames() const { return writer_.frames(); }
@@ -59,6 +60,7 @@ class FrameSink {
   Timestamp period_us_;
   SensorSize sensor_;
   RenderOptions render_;
+  LinePicture picture_;
   FrameWriter writer_;
   cv::Mat canvas_;
   Timestamp next_render_ = 0;
@@ -83,13 +85,15 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   if (!options.whole_lines.empty()) whole_csv.emplace(options.whole_lines);
   WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
   std::vector<TrackedLine> joined;
+  const bool join = whole_csv || frames.draws_whole_lines();
   pipeline.set_output(options.output_period_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice& lattice) {
     csv.write_step(t, lines.lines());
-    frames.step(t, lines, lattice);
-    if (!whole_csv) return;
-    joiner.update(t, lines.lines(), &lattice);
-    as_tracked_lines(joiner.lines(), joined);
-    whole_csv->write_step(t, joined);
+    if (join) {
+      joiner.update(t, lines.lines(), &lattice);
+      as_tracked_lines(joiner.lines(), joined);
+    }
+    if (whole_csv) whole_csv->write_step(t, joined);
+    frames.step(t, lines, joined, lattice);
   });
 
   spdlog::info("{}: {}x{}, b={} N={} dq={} f_th={}", source.name(), sensor->width, sensor->height, config.lattice.block_size, pipeline.lattice().geometry().capacity,
@@ -157,13 +161,15 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{1}, Timestamp{60'000'000}));
   app.add_option("--summary-json", options.summary_json, "Also write the summary as JSON");
-  app.add_option("--video", options.video, "Render an mp4 of events and segments");
+  app.add_option("--video", options.video, "Render an mp4 of events, segments and whole lines");
   app.add_option("--frames", options.frames_dir, "Render PNG frames into this directory");
   app.add_option("--render-period-us", options.render_period_us, "Event time between rendered frames")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{1}, Timestamp{60'000'000}));
-  app.add_option("--render-scale", options.render_scale, "Zoom of rendered frames")->capture_default_str()->check(CLI::Range(1, 8));
-  app.add_flag("--show-ids", options.show_ids, "Write line ids on rendered frames");
+  app.add_option("--render-scale", options.render.scale, "Zoom of rendered frames")->capture_default_str()->check(CLI::Range(1, 8));
+  app.add_flag("!--no-whole-lines", options.render.show_whole_lines, "Rendered frames without the whole lines");
+  app.add_flag("!--no-ids", options.render.show_whole_line_ids, "Rendered frames without the whole lines' ids");
+  app.add_flag("--segment-ids", options.render.show_segment_ids, "Write the segments' ids on rendered frames too");
   app.add_flag("-q,--quiet", options.quiet, "No progress lines");
   pipeline_options.add_to(app);
   return run_main(app, argc, argv, [&] { return run(options, pipeline_options, source_options); });

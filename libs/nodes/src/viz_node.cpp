@@ -17,17 +17,6 @@ std::span<const std::uint8_t> payload_of(const lcm::ReceiveBuffer* buffer) {
   return {static_cast<const std::uint8_t*>(buffer->data), buffer->data_size};
 }
 
-/// The fields of a text of items separated by ", " (kLayerKeys).
-std::vector<std::string> split_items(std::string_view text) {
-  std::vector<std::string> items;
-  for (std::size_t start = 0; start <= text.size();) {
-    const std::size_t comma = std::min(text.find(", ", start), text.size());
-    items.emplace_back(text.substr(start, comma - start));
-    start = comma + 2;
-  }
-  return items;
-}
-
 }  // namespace
 
 VizNode::VizNode(lcm::LCM& lcm, VizNodeOptions options)
@@ -96,44 +85,38 @@ void VizNode::on_stats(const lcm::ReceiveBuffer* buffer, const std::string&) {
 
 void VizNode::render(cv::Mat& canvas) {
   const SensorSize sensor = *receiver_.sensor();
-  ids_.clear();
-  for (const TrackedLine& line : lines_) ids_.push_back(line.id);
-  short_ids_.label(ids_, labels_);
   RenderOptions render = options_.render;
   render.grid_block_size = lattice_->geometry().block_size;
-  render_scene(sensor, lattice_->surface(), lines_, render, canvas, labels_);
-  if (render.show_whole_lines) {
-    ids_.clear();
-    for (const TrackedLine& line : whole_lines_) ids_.push_back(line.id);
-    short_whole_ids_.label(ids_, labels_);
-    draw_whole_lines(whole_lines_, render, canvas, labels_);
-  }
-  // Each group of fields wraps to the picture's width; time is since the first event seen (a real
-  // recording's clock is its epoch).
-  const ReceiverCounts counts = receiver_.counts();
+  picture_.draw(sensor, lattice_->surface(), lines_, whole_lines_, render, canvas);
+  if (stats_) draw_masked_pixels(sensor, stats_->masked_pixels, options_.render.scale, canvas);
+  update_status();
+  // Each group of fields wraps to the picture's width.
+  int row = 0;
+  for (const auto& group : status_) row = put_text_lines(canvas, wrap_fields(group, canvas.cols), row);
+  if (options_.show_key_help) put_text_lines(canvas, wrap_fields(layer_key_help(), canvas.cols), row);
+}
+
+void VizNode::update_status() {
+  status_.clear();
+  // Time is since the first event seen (a real recording's clock is its epoch).
   const double since_first_s = first_event_us_ ? static_cast<double>(lines_t_us_ - *first_event_us_) * 1e-6 : 0.0;
-  const auto put = [&](const std::vector<std::string>& fields, int row) { return put_text_lines(canvas, wrap_fields(fields, canvas.cols), row); };
-  int row = put({options_.camera, fmt::format("t={:.3f} s", std::max(0.0, since_first_s)), fmt::format("{:.2f} Mev/s", event_rate_ * 1e-6),
-                 fmt::format("{} lines", lines_.size()), fmt::format("{} whole", whole_lines_.size())},
-                0);
+  status_.push_back({options_.camera, fmt::format("t={:.3f} s", std::max(0.0, since_first_s)), fmt::format("{:.2f} Mev/s", event_rate_ * 1e-6),
+                     fmt::format("{} lines", lines_.size()), fmt::format("{} whole", whole_lines_.size())});
   if (stats_) {
-    draw_masked_pixels(sensor, stats_->masked_pixels, options_.render.scale, canvas);
-    row = put({fmt::format("detect {:.0f} Hz", stats_->detect_hz), fmt::format("track {:.0f} Hz", stats_->track_hz),
-               fmt::format("latency {:.1f}/{:.1f} ms", stats_->latency_median_ms, stats_->latency_p99_ms),
-               fmt::format("lost {}", stats_->batches_lost), fmt::format("shed {}", stats_->batches_shed),
-               fmt::format("hot pixels {}", stats_->num_masked_pixels)},
-              row);
+    status_.push_back({fmt::format("detect {:.0f} Hz", stats_->detect_hz), fmt::format("track {:.0f} Hz", stats_->track_hz),
+                       fmt::format("latency {:.1f}/{:.1f} ms", stats_->latency_median_ms, stats_->latency_p99_ms),
+                       fmt::format("lost {}", stats_->batches_lost), fmt::format("shed {}", stats_->batches_shed),
+                       fmt::format("hot pixels {}", stats_->num_masked_pixels)});
   } else {
-    row = put({"no statistics from evldt-lines yet"}, row);
+    status_.push_back({"no statistics from evldt-lines yet"});
   }
   if (camera_stats_ && camera_stats_->sensor_lag_samples > 0) {
-    row = put({fmt::format("camera: sensor lag {:.1f}/{:.1f} ms", camera_stats_->sensor_lag_median_ms, camera_stats_->sensor_lag_p99_ms)},
-              row);
+    status_.push_back({fmt::format("camera: sensor lag {:.1f}/{:.1f} ms", camera_stats_->sensor_lag_median_ms, camera_stats_->sensor_lag_p99_ms)});
   }
+  const ReceiverCounts counts = receiver_.counts();
   if (counts.sequence.lost || counts.invalid_messages) {
-    row = put({fmt::format("viz: {} batches lost", counts.sequence.lost), fmt::format("{} invalid", counts.invalid_messages)}, row);
+    status_.push_back({fmt::format("viz: {} batches lost", counts.sequence.lost), fmt::format("{} invalid", counts.invalid_messages)});
   }
-  if (options_.show_key_help) put(split_items(kLayerKeys), row);
 }
 
 bool VizNode::handle_pending(Clock::time_point deadline) {

@@ -37,16 +37,23 @@ cv::Scalar status_colour(LineStatus status) {
   return {255, 255, 255};
 }
 
+const Layer* find_layer(int key) {
+  const auto* layer = std::ranges::find(kLayers, key, [](const Layer& l) { return static_cast<int>(l.key); });
+  return layer == kLayers.end() ? nullptr : layer;
+}
+
 bool toggle_layer(RenderOptions& options, int key) {
-  switch (key) {
-    case 'e': options.show_events = !options.show_events; return true;
-    case 's': options.show_segments = !options.show_segments; return true;
-    case 'b': options.show_bad_tracks = !options.show_bad_tracks; return true;
-    case 'g': options.show_grid = !options.show_grid; return true;
-    case 'i': options.show_ids = !options.show_ids; return true;
-    case 'w': options.show_whole_lines = !options.show_whole_lines; return true;
-    default: return false;
-  }
+  const Layer* layer = find_layer(key);
+  if (layer == nullptr) return false;
+  options.*(layer->shown) = !(options.*(layer->shown));
+  return true;
+}
+
+std::vector<std::string> layer_key_help() {
+  std::vector<std::string> fields;
+  for (const Layer& layer : kLayers) fields.push_back(std::string(fields.empty() ? "keys: " : "") + layer.key + " " + layer.name);
+  fields.emplace_back("q quit");
+  return fields;
 }
 
 void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std::span<const TrackedLine> lines,
@@ -78,7 +85,7 @@ void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std
     const TrackedLine& line = lines[i];
     const bool bad = line.status == LineStatus::BadTrack;
     if (bad ? !options.show_bad_tracks : !options.show_segments) continue;
-    draw_labelled(canvas, line, status_colour(line.status), thickness, scale, options.show_ids, i < labels.size() ? labels[i] : line.id);
+    draw_labelled(canvas, line, status_colour(line.status), thickness, scale, options.show_segment_ids, i < labels.size() ? labels[i] : line.id);
   }
 }
 
@@ -98,7 +105,7 @@ void draw_whole_lines(std::span<const TrackedLine> lines, const RenderOptions& o
   const int scale = std::max(1, options.scale);
   const cv::Scalar cyan(230, 210, 40);
   for (std::size_t i = 0; i < lines.size(); ++i) {
-    draw_labelled(canvas, lines[i], cyan, std::max(2, scale), scale, options.show_ids, i < labels.size() ? labels[i] : lines[i].id);
+    draw_labelled(canvas, lines[i], cyan, std::max(2, scale), scale, options.show_whole_line_ids, i < labels.size() ? labels[i] : lines[i].id);
   }
 }
 

@@ -12,7 +12,7 @@
 
 #include "evldt/lines/params.hpp"
 #include "evldt/render/scene_renderer.hpp"
-#include "evldt/render/short_ids.hpp"
+#include "evldt/render/line_picture.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 
@@ -50,9 +50,13 @@ class VizNode {
   /// has already arrived (for at most kStopDrain) so that the totals count it. Everything runs on the calling thread
   /// (window toolkits need it).
   void run(const std::atomic<bool>& stop, const FrameHandler& on_frame);
-  /// A key pressed in the window: toggles a layer of kLayerKeys from the next frame on; false for
+  /// A key pressed in the window: toggles a layer of kLayers from the next frame on; false for
   /// other keys. Call from the thread that runs the node (the frame handler).
   bool apply_key(int key) { return toggle_layer(options_.render, key); }
+  /// What the last frame drew, for a view elsewhere (call from the thread that runs the node).
+  [[nodiscard]] const RenderOptions& render_options() const { return options_.render; }
+  /// The last frame's status text: groups of fields, each group drawn from a new line.
+  [[nodiscard]] const std::vector<std::vector<std::string>>& status() const { return status_; }
   /// Counts so far (call from the thread that runs the node, e.g. in the frame handler, or after run).
   [[nodiscard]] VizTotals totals() const;
   /// Long enough for a viewer that fell behind on a starved host (a ThreadSanitizer build beside two
@@ -71,6 +75,7 @@ class VizNode {
   bool decode_list(const lcm::ReceiveBuffer* buffer, std::vector<TrackedLine>& into);
   void on_stats(const lcm::ReceiveBuffer* buffer, const std::string& channel);
   void render(cv::Mat& canvas);
+  void update_status();
 
   lcm::LCM& lcm_;
   VizNodeOptions options_;
@@ -83,14 +88,13 @@ class VizNode {
   segment_list_t lines_msg_;
   std::vector<TrackedLine> lines_, incoming_;
   std::vector<TrackedLine> whole_lines_;
-  ShortIds short_ids_, short_whole_ids_;  // label the ids of each drawn list
-  std::vector<std::uint64_t> ids_;
-  std::vector<std::uint32_t> labels_;
+  LinePicture picture_;
   Timestamp lines_t_us_ = 0;
   std::optional<Timestamp> first_event_us_;  ///< of the stream (since its last restart), for the time shown
   stats_t stats_msg_;
   std::optional<stats_t> stats_;
   std::optional<stats_t> camera_stats_;  ///< our camera service's, for a live source's lag
+  std::vector<std::vector<std::string>> status_;
   VizTotals totals_;
 };
 
