@@ -31,6 +31,7 @@ struct Options {
   std::filesystem::path segments, whole_lines, ground_truth, frames_gt, write_gt, json, pr_png, lifetime_png, tracks_png;
   LsdParams lsd;
   std::string lcm_channel;
+  std::string label;  ///< of the --segments row
   std::string frames_topic;  ///< of a bag or HDF5 file given to --frames-gt
   std::vector<double> tolerances{0.01, 0.02};
   std::vector<float> pr_thresholds;
@@ -340,7 +341,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     if (!options.whole_lines.empty()) support = file_support(rows, options.whole_lines);
     last.emplace(evaluate_files(options, std::move(rows), *sensor, sim));
     reports.push_back(make_report(*last));
-    reports.back().label = options.segments.filename().string();
+    reports.back().label = options.label.empty() ? options.segments.filename().string() : options.label;
     reports.back().support = support;
     write_run_plots(options, *last, reports.back(), false);
     const StepCoverage& c = last->coverage();
@@ -428,7 +429,9 @@ int main(int argc, char** argv) {
                  "Whole lines (evldt-offline --whole-lines) of the run --segments comes from: their support by its "
                  "segments (share of their length within 2 px of a segment of the same step); no ground truth needed")
       ->check(CLI::ExistingFile);
-  app.add_option("--lcm-channel", options.lcm_channel, "Segment channel of an lcm-log (default: the first LINES_*)");
+  app.add_option("--lcm-channel", options.lcm_channel,
+                 "Segment channel of an lcm-log (default: the first LINES_*; WHOLE_LINES_<CAMERA> for the whole lines)");
+  app.add_option("--label", options.label, "Name of the --segments row (default: the file's name)");
   app.add_option("--ground-truth", options.ground_truth, "Ground-truth CSV (from evldt-sim)")->check(CLI::ExistingFile);
   app.add_option("--frames-gt", options.frames_gt,
                  "Ground truth as the paper makes it: LSD on the intensity frames of this ECD folder (images.txt and "
