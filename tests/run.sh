@@ -9,8 +9,9 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 # What the tests need beyond the product: clang and libFuzzer for the fuzz targets, iproute2 for
-# the multi-host test's network namespaces, Chromium for the web view's browser test.
-deploy/install-deps.sh clang libclang-rt-14-dev iproute2 chromium
+# the multi-host test's network namespaces, Chromium for the web view's browser test, Node.js (npm)
+# to check exported MCAP files against Foxglove's published schemas.
+deploy/install-deps.sh clang libclang-rt-14-dev iproute2 chromium nodejs
 source tests/suites.sh
 started=$SECONDS
 

@@ -57,11 +57,19 @@ struct Record {
 struct Channel {
   std::string topic, type, encoding;
   std::string definition;  // the schema's data: the .msg text of a ros1msg / ros2msg schema
+  std::string schema_encoding, schema_data;  // of any schema
 };
+
+/// A channel in a ROS serialization, and which.
+bool ros_serialized(const Channel& channel) { return channel.encoding == "ros1" || channel.encoding == "cdr"; }
+RosSerialization ros_serialization(const Channel& channel) {
+  return channel.encoding == "ros1" ? RosSerialization::Ros1 : RosSerialization::Cdr;
+}
 
 struct Schema {
   std::string name;
   std::string definition;
+  std::string encoding, data;
 };
 
 /// One channel of an MCAP file, its messages read in file order: the channel `wanted`, or if empty
@@ -71,7 +79,8 @@ struct Schema {
 /// std::runtime_error naming the file for a file it cannot read or no such channel.
 class McapChannel {
  public:
-  using Accepts = std::function<bool(const std::string& type, RosSerialization serialization, const std::string& definition)>;
+  /// Whether a channel is one to read.
+  using Accepts = std::function<bool(const Channel& channel)>;
   McapChannel(const std::filesystem::path& path, const std::string& topic, Accepts accepts, std::string kind, std::string expected)
       : file_(path, "MCAP"), path_(file_.path()), wanted_(topic), accepts_(std::move(accepts)), kind_(std::move(kind)),
         expected_(std::move(expected)) {
@@ -97,11 +106,13 @@ class McapChannel {
     Record record;
     while (next_record(record)) {
       if (!handle(record)) continue;
-      location = "message " + std::to_string(read_) + " of " + topic_ + " (record at byte " + std::to_string(record.offset) + ")";
+      location = "message " + std::to_string(read_) + " of " + channel_.topic + " (record at byte " + std::to_string(record.offset) + ")";
       offset = record.offset;
       try {
         FieldReader fields(record.content);
-        fields.take(2 + 4 + 8 + 8);  // channel id, sequence, log time, publish time
+        fields.take(2 + 4);  // channel id, sequence
+        log_time_ns_ = fields.read<std::uint64_t>();
+        fields.take(8);  // publish time
         message = fields.rest();
       } catch (const std::runtime_error& error) {
         throw FormatError(path_, record.offset, location + ": " + error.what());
@@ -113,14 +124,17 @@ class McapChannel {
   }
 
   [[nodiscard]] const std::string& path() const { return path_; }
-  [[nodiscard]] const std::string& topic() const { return topic_; }
-  [[nodiscard]] const std::string& type() const { return type_; }
-  [[nodiscard]] const std::string& definition() const { return definition_; }
-  [[nodiscard]] RosSerialization serialization() const { return serialization_; }
+  [[nodiscard]] const Channel& channel() const { return channel_; }
+  [[nodiscard]] const std::string& topic() const { return channel_.topic; }
+  [[nodiscard]] const std::string& type() const { return channel_.type; }
+  [[nodiscard]] const std::string& definition() const { return channel_.definition; }
+  [[nodiscard]] RosSerialization serialization() const { return ros_serialization(channel_); }
   [[nodiscard]] double progress() const {
     return file_.size() == 0 ? 1.0 : static_cast<double>(file_.position()) / static_cast<double>(file_.size());
   }
   [[nodiscard]] std::uint64_t skipped() const { return skipped_; }
+  /// Of the message next() returned last.
+  [[nodiscard]] std::uint64_t log_time_ns() const { return log_time_ns_; }
 
  private:
   /// The next record of the data section, from the current chunk or the file; false at its end.
@@ -169,19 +183,24 @@ class McapChannel {
           const auto id = fields.read<std::uint16_t>();
           Schema& schema = schemas_[id];
           schema.name = fields.read_string();
-          const std::string encoding = fields.read_string();
-          const std::string data = fields.read_string();  // uint32-prefixed bytes, as a string is
-          schema.definition = encoding == "ros1msg" || encoding == "ros2msg" ? data : std::string();
+          schema.encoding = fields.read_string();
+          schema.data = fields.read_string();  // uint32-prefixed bytes, as a string is
+          schema.definition = schema.encoding == "ros1msg" || schema.encoding == "ros2msg" ? schema.data : std::string();
           return false;
         }
         case kChannel: {
           const auto id = fields.read<std::uint16_t>();
           const auto schema = fields.read<std::uint16_t>();
-          Channel channel{fields.read_string(), {}, {}, {}};
+          Channel channel;
+          channel.topic = fields.read_string();
           channel.encoding = fields.read_string();
           const auto found = schemas_.find(schema);
           channel.type = found == schemas_.end() ? "no schema" : found->second.name;
-          if (found != schemas_.end()) channel.definition = found->second.definition;
+          if (found != schemas_.end()) {
+            channel.definition = found->second.definition;
+            channel.schema_encoding = found->second.encoding;
+            channel.schema_data = found->second.data;
+          }
           consider(id, channel);
           channels_[id] = std::move(channel);
           return false;
@@ -207,18 +226,13 @@ class McapChannel {
 
   void consider(std::uint16_t id, const Channel& channel) {
     if (channel_id_ >= 0 || (!wanted_.empty() && channel.topic != wanted_)) return;
-    const bool ros1 = channel.encoding == "ros1", cdr = channel.encoding == "cdr";
-    const RosSerialization serialization = ros1 ? RosSerialization::Ros1 : RosSerialization::Cdr;
-    if (!((ros1 || cdr) && accepts_(channel.type, serialization, channel.definition))) {
+    if (!accepts_(channel)) {
       if (wanted_.empty()) return;
       throw std::runtime_error("'" + path_ + "': channel " + channel.topic + " is of type " + channel.type + " (" + channel.encoding +
                                "), not " + expected_);
     }
     channel_id_ = id;
-    topic_ = channel.topic;
-    type_ = channel.type;
-    definition_ = channel.definition;
-    serialization_ = serialization;
+    channel_ = channel;
   }
 
   void open_chunk(FieldReader& fields, std::uint64_t offset) {
@@ -261,16 +275,16 @@ class McapChannel {
   int channel_id_ = -1;
   Accepts accepts_;
   std::string kind_, expected_;
-  std::string topic_, type_, definition_;
-  RosSerialization serialization_ = RosSerialization::Cdr;
+  Channel channel_;  // the one read
   std::uint64_t read_ = 0, skipped_ = 0;
+  std::uint64_t log_time_ns_ = 0;
 };
 
 class McapSource final : public PacketSource {
  public:
   McapSource(const std::filesystem::path& path, const std::string& topic)
-      : channel_(path, topic, [](const std::string& type, RosSerialization serialization, const std::string& definition) {
-          return RosEventLayout::of(serialization, type, definition).has_value();
+      : channel_(path, topic, [](const Channel& channel) {
+          return ros_serialized(channel) && RosEventLayout::of(ros_serialization(channel), channel.type, channel.definition).has_value();
         }, "an event type", "an event type evldt reads"),
         layout_(*RosEventLayout::of(channel_.serialization(), channel_.type(), channel_.definition())) {}
 
@@ -304,8 +318,8 @@ class McapSource final : public PacketSource {
 class McapImageSource final : public ImageSource {
  public:
   McapImageSource(const std::filesystem::path& path, const std::string& topic)
-      : channel_(path, topic, [](const std::string& type, RosSerialization, const std::string&) {
-          return type == kRos2ImageType || type == kRos1ImageType;
+      : channel_(path, topic, [](const Channel& channel) {
+          return ros_serialized(channel) && (channel.type == kRos2ImageType || channel.type == kRos1ImageType);
         }, "type " + std::string(kRos2ImageType), std::string(kRos2ImageType)) {}
 
   bool next(RecordingImage& image, std::string& location) override {
@@ -337,6 +351,24 @@ std::unique_ptr<PacketSource> open_mcap(const std::filesystem::path& path, const
 
 std::unique_ptr<ImageSource> open_mcap_images(const std::filesystem::path& path, const std::string& topic) {
   return std::make_unique<McapImageSource>(path, topic);
+}
+
+McapChannelMessages read_mcap_channel(const std::filesystem::path& path, const std::string& topic) {
+  McapChannel reader(path, topic, [](const Channel&) { return true; }, "any type", "any type");
+  McapChannelMessages out;
+  const Channel& channel = reader.channel();
+  out.topic = channel.topic;
+  out.schema_name = channel.type;
+  out.schema_encoding = channel.schema_encoding;
+  out.schema = channel.schema_data;
+  out.message_encoding = channel.encoding;
+  std::span<const std::uint8_t> message;
+  std::string location;
+  std::uint64_t offset = 0;
+  while (reader.next(message, location, offset)) {
+    out.messages.push_back({reader.log_time_ns(), std::string(reinterpret_cast<const char*>(message.data()), message.size())});
+  }
+  return out;
 }
 
 }  // namespace evldt

@@ -4,10 +4,12 @@
 // uncompressed, LZ4 or Zstandard; their CRC is checked. Channels in CDR ("ros2msg" schemas) or ROS 1
 // serialization ("ros1msg") with an event message type (ros_messages.hpp) are read.
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "evldt/containers/packet_source.hpp"
 
@@ -25,5 +27,19 @@ class ImageSource;
 /// CDR or ROS 1 serialization, in file order. Throws std::runtime_error naming the file if it is no
 /// MCAP file or has no such channel.
 std::unique_ptr<ImageSource> open_mcap_images(const std::filesystem::path& path, const std::string& topic);
+
+/// One channel's messages, whatever their encoding.
+struct McapChannelMessages {
+  struct Message {
+    std::uint64_t log_time_ns;
+    std::string data;
+  };
+  std::string topic, schema_name, schema_encoding, schema, message_encoding;
+  std::vector<Message> messages;
+};
+/// Every message of channel `topic` (empty: the first channel) in file order, with its channel's
+/// schema: for reading back what evldt wrote (evldt-export) and for tools. Throws std::runtime_error
+/// naming the file if it is no MCAP file, is cut short, or has no such channel.
+McapChannelMessages read_mcap_channel(const std::filesystem::path& path, const std::string& topic);
 
 }  // namespace evldt
