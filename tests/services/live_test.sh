@@ -56,7 +56,7 @@ live_path() {  # live_path NAME COMMAND...: the camera on a live input (COMMAND 
   kill "$probe_pid" 2>/dev/null
   check "$name: evldt-lines received every batch ($batches)" grep -q "batches   $batches received, 0 lost" "$work/$name.lines.out"
   # The viz is a display: when it falls behind (a sanitizer's build at a thousand batches a second)
-  # it loses its own batches, counted, by design (README: a slow viz never slows the others). What
+  # it loses its own batches, counted, by design (docs/services.md: a slow viz never slows the others). What
   # is checked here is that it drew the live stream; every batch reaching evldt-lines is checked above.
   check "$name: evldt-viz received the live stream" grep -qP "received  [1-9][0-9]* batches \\([0-9]+ lost" "$work/$name.viz.out"
 }

@@ -41,7 +41,7 @@ struct TrackParams {
   float perturbation_px = 2.5f;  ///< dq
   /// Event time a line may go without a good track before it is released: 30 ms keeps every scene's
   /// F@1% at or above that of the former 10 rounds (20 ms); 80 ms gains slow clean scenes 0.02 more
-  /// and costs the dark one as much (README, tracks that last).
+  /// and costs the dark one as much (docs/accuracy.md, tracks that last).
   Timestamp bad_track_patience_us = 30'000;
   EffectiveRatioNorm multi_block_norm = EffectiveRatioNorm::Block;
   ReassociationParams reassociation;

@@ -28,7 +28,7 @@
 namespace evldt {
 
 /// The default latency budget: well above the queueing of a service that keeps up (a few ms), well
-/// below answers too old to steer by (README, real time under load).
+/// below answers too old to steer by (docs/realtime.md).
 inline constexpr double kDefaultMaxLatencyMs = 20;
 
 struct LinesNodeOptions {

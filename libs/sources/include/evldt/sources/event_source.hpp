@@ -1,5 +1,5 @@
 #pragma once
-// Where events come from, behind one interface: a recording file (every format of README's table,
+// Where events come from, behind one interface: a recording file (every format of README's Formats table,
 // an lcm-log of event batches among them), a built-in simulated scene, or a video file / webcam turned into
 // events by frame differencing. The offline runner and the camera service read through it.
 
