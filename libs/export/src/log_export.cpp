@@ -89,7 +89,9 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
       }
       for (std::size_t i = 0; i < batch.size(); ++i) lattice->insert(batch.x[i], batch.y[i]);
       if (event->timestamp < next_image_us) continue;
-      next_image_us = std::max(next_image_us + period_us, event->timestamp);
+      // A picture a period after the last; after a pause in the recording, a period after this one.
+      next_image_us += period_us;
+      if (next_image_us <= event->timestamp) next_image_us = event->timestamp + period_us;
       render_scene(*receiver.sensor(), lattice->surface(), {}, render, canvas);
       cv::imencode(".jpg", canvas, jpeg, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
       mcap.write(image_channel, time_ns, compressed_image_json(time_ns, counts.camera, jpeg));
