@@ -48,7 +48,6 @@ stops_promptly "$logger_pid" INT >/dev/null
 check "evldt-export exits 0" test $? -eq 0
 cat "$work/export.out"
 pictures=$(field "$work/export.out" 'written')
-check "pictures at 20 Hz of a 1 s run (${pictures:-none})" test "${pictures:-0}" -ge 18 -a "${pictures:-0}" -le 22
 check "segment lists and whole-line lists written" grep -qP 'pictures, [1-9][0-9]* segment lists, [1-9][0-9]* whole-line lists, [1-9][0-9]* statistics' "$work/export.out"
 check "the undecodable messages counted (3 batches, 2 lists)" grep -q "skipped   5 undecodable" "$work/export.out"
 check "the undecodable messages reported" grep -q "5 undecodable messages of camera cam0 skipped" "$work/export.err"
@@ -56,6 +55,13 @@ for topic in events segments whole_lines stats; do
   "$dump" "$work/run.mcap" "/cam0/$topic" >"$work/$topic.dump" 2>"$work/$topic.err"
   check "evldt's MCAP reader reads /cam0/$topic back" test $? -eq 0
 done
+# Pictures at 20 Hz of recording time: picture k no earlier than k periods after the first, and as
+# many as the recording's span allows (lcm-logger's clock: a loaded machine stretches the 1 s run).
+picture_times() { tail -n +3 "$work/events.dump" | grep -oP '"timestamp": \{"sec": \K[0-9]+, "nsec": [0-9]+' | awk -F', "nsec": ' '{ printf "%.6f\n", $1 + $2 * 1e-9 }'; }
+read -r early most < <(picture_times | awk 'NR == 1 { first = $1 } { late = $1 - first - (NR - 1) * 0.05; if (NR == 1 || late < least) least = late; last = $1 }
+  END { printf "%d %d\n", least < -1e-6, int((last - first) / 0.05 + 1e-6) + 1 }')
+check "pictures at 20 Hz: ${pictures:-none} of at most ${most:-?}, none early" \
+  awk -v n="${pictures:-0}" -v most="${most:-0}" -v early="${early:-1}" 'BEGIN { exit !(n >= 15 && n <= most && early == 0) }'
 check "the pictures' channel is foxglove.CompressedImage in JSON" grep -q "^foxglove.CompressedImage jsonschema json $pictures\$" "$work/events.dump"
 check "the segments' channel is foxglove.ImageAnnotations" grep -q "^foxglove.ImageAnnotations jsonschema json " "$work/segments.dump"
 check "whole lines carry their ids as texts" grep -qP '"texts": \[\{"timestamp": \{"sec": [0-9]+, "nsec": [0-9]+\}, "position"' "$work/whole_lines.dump"
