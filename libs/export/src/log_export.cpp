@@ -13,14 +13,11 @@
 #include "evldt/scarf/scarf_lattice.hpp"
 #include "evldt/transport/channels.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
+#include "evldt/transport/lcm_log.hpp"
 #include "evldt/transport/messages.hpp"
 
 namespace evldt {
 namespace {
-
-std::span<const std::uint8_t> payload(const lcm::LogEvent& event) {
-  return {static_cast<const std::uint8_t*>(event.data), static_cast<std::size_t>(std::max(event.datalen, 0))};
-}
 
 bool same_camera(const std::string& a, const std::string& b) {
   return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return std::toupper(x) == std::toupper(y); });
@@ -28,8 +25,8 @@ bool same_camera(const std::string& a, const std::string& b) {
 
 /// The camera of the first EVENTS_* channel, or empty.
 std::string first_camera(const std::filesystem::path& path) {
-  lcm::LogFile log(path.string(), "r");
-  while (const lcm::LogEvent* event = log.readNextEvent()) {
+  const auto log = open_lcm_log(path);
+  while (const lcm::LogEvent* event = log->readNextEvent()) {
     if (event->channel.starts_with("EVENTS_")) return event->channel.substr(7);
   }
   return {};
@@ -42,8 +39,7 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
   if (!(options.image_hz > 0 && options.image_hz <= 1000)) throw std::invalid_argument("picture rate must be in (0, 1000] Hz");
   if (options.scale < 1 || options.scale > 8) throw std::invalid_argument("scale must be in 1..8");
   if (options.jpeg_quality < 1 || options.jpeg_quality > 100) throw std::invalid_argument("JPEG quality must be in 1..100");
-  lcm::LogFile log(log_path.string(), "r");
-  if (!log.good()) throw std::runtime_error("cannot open LCM log " + log_path.string());
+  const auto log = open_lcm_log(log_path);
   LogExportCounts counts;
   counts.camera = options.camera.empty() ? first_camera(log_path) : options.camera;
   if (counts.camera.empty()) throw std::runtime_error("no event batches (EVENTS_* channel) in LCM log " + log_path.string());
@@ -75,10 +71,10 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
   const AnnotationStyle segment_style{.thickness = 1, .by_status = true};
   const AnnotationStyle whole_line_style{.thickness = 2, .by_status = false, .ids = true};
   bool any_batch = false;
-  while (const lcm::LogEvent* event = log.readNextEvent()) {
+  while (const lcm::LogEvent* event = log->readNextEvent()) {
     const auto time_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(event->timestamp, 0)) * 1000u;
     if (event->channel == events) {
-      if (!receiver.receive(payload(*event), batch)) {
+      if (!receiver.receive(log_payload(*event), batch)) {
         ++counts.invalid;
         continue;
       }
@@ -97,7 +93,7 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
       mcap.write(image_channel, time_ns, compressed_image_json(time_ns, counts.camera, jpeg));
       ++counts.images;
     } else if (event->channel == lines || event->channel == whole_lines) {
-      if (decode_message(payload(*event), list) != WireError::None || !read_segment_list(list, tracked)) {
+      if (decode_message(log_payload(*event), list) != WireError::None || !read_segment_list(list, tracked)) {
         ++counts.invalid;
         continue;
       }
@@ -106,7 +102,7 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
                  image_annotations_json(time_ns, tracked, whole ? whole_line_style : segment_style, options.scale));
       ++(whole ? counts.whole_line_lists : counts.segment_lists);
     } else if (event->channel == kStatsChannel) {
-      if (decode_message(payload(*event), stats) != WireError::None) {
+      if (decode_message(log_payload(*event), stats) != WireError::None) {
         ++counts.invalid;
         continue;
       }
@@ -120,6 +116,7 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
       ++counts.other_messages;
     }
   }
+  report_unread_tail(*log, log_path);
   if (!any_batch) throw std::runtime_error("no valid event batch on " + events + " in LCM log " + log_path.string());
   mcap.close();
   return counts;

@@ -11,21 +11,22 @@
 namespace evldt {
 namespace {
 
-std::unique_ptr<lcm::LogFile> open_log(const std::filesystem::path& path) {
+bool channel_matches(const std::string& wanted, std::string_view prefix, const std::string& channel) {
+  return wanted.empty() ? channel.starts_with(prefix) : channel == wanted;
+}
+
+}  // namespace
+
+std::unique_ptr<lcm::LogFile> open_lcm_log(const std::filesystem::path& path) {
   auto log = std::make_unique<lcm::LogFile>(path.string(), "r");
   if (!log->good()) throw std::runtime_error("cannot open LCM log " + path.string());
   return log;
 }
 
-bool channel_matches(const std::string& wanted, std::string_view prefix, const std::string& channel) {
-  return wanted.empty() ? channel.starts_with(prefix) : channel == wanted;
-}
-
-std::span<const std::uint8_t> payload(const lcm::LogEvent& event) {
+std::span<const std::uint8_t> log_payload(const lcm::LogEvent& event) {
   return {static_cast<const std::uint8_t*>(event.data), static_cast<std::size_t>(std::max(event.datalen, 0))};
 }
 
-// LogFile stops at the first event it cannot read; say so if that was before the end of the file.
 void report_unread_tail(lcm::LogFile& log, const std::filesystem::path& path) {
   const long position = std::ftell(log.getFilePtr());
   std::error_code error;
@@ -35,8 +36,6 @@ void report_unread_tail(lcm::LogFile& log, const std::filesystem::path& path) {
                  path.string(), position, size);
   }
 }
-
-}  // namespace
 
 bool is_lcm_log(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -48,7 +47,7 @@ bool is_lcm_log(const std::filesystem::path& path) {
 LcmLogEventReader::LcmLogEventReader(const std::filesystem::path& path, std::string channel,
                                      Timestamp backwards_slack_us)
     : path_(path), channel_(std::move(channel)), receiver_(std::nullopt, backwards_slack_us) {
-  log_ = open_log(path_);
+  log_ = open_lcm_log(path_);
   std::error_code error;
   file_size_ = std::filesystem::file_size(path_, error);
   if (!next_batch(first_)) {
@@ -63,7 +62,7 @@ LcmLogEventReader::~LcmLogEventReader() = default;
 bool LcmLogEventReader::next_batch(EventBatch& out) {
   while (const lcm::LogEvent* event = log_->readNextEvent()) {
     if (!channel_matches(channel_, "EVENTS_", event->channel)) continue;
-    if (!receiver_.receive(payload(*event), out)) continue;
+    if (!receiver_.receive(log_payload(*event), out)) continue;
     if (channel_.empty()) channel_ = event->channel;
     return true;
   }
@@ -86,7 +85,7 @@ double LcmLogEventReader::progress() const {
 }
 
 std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std::string channel) {
-  const auto log = open_log(path);
+  const auto log = open_lcm_log(path);
   std::vector<SegmentRow> rows;
   std::uint64_t invalid = 0;
   segment_list_t msg;
@@ -96,7 +95,7 @@ std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std:
   bool any_list = false;
   while (const lcm::LogEvent* event = log->readNextEvent()) {
     if (!channel_matches(channel, "LINES_", event->channel)) continue;
-    if (decode_message(payload(*event), msg) != WireError::None || !read_segment_list(msg, lines)) {
+    if (decode_message(log_payload(*event), msg) != WireError::None || !read_segment_list(msg, lines)) {
       ++invalid;
       continue;
     }

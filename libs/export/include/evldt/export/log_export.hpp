@@ -25,8 +25,9 @@ struct LogExportCounts {
   std::uint64_t other_messages = 0; ///< of other channels or cameras (not exported)
 };
 
-/// Writes `mcap` from `log`. Throws std::runtime_error naming the file for a log that cannot be
-/// read or holds no event batch of the camera, std::invalid_argument for bad options.
+/// Writes `mcap` from `log`; a log LCM stops reading early gives what was read before, with a
+/// warning (report_unread_tail). Throws std::runtime_error naming the file for a log that cannot be
+/// opened or holds no event batch of the camera, std::invalid_argument for bad options.
 LogExportCounts export_log_to_mcap(const std::filesystem::path& log, const std::filesystem::path& mcap, const LogExportOptions& options);
 
 }  // namespace evldt

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -14,12 +15,20 @@
 
 namespace lcm {
 class LogFile;
+struct LogEvent;
 }
 
 namespace evldt {
 
 /// True if the file starts like an LCM log (the event sync word 0xEDA1DA01).
 bool is_lcm_log(const std::filesystem::path& path);
+/// Opens an LCM log to read; throws std::runtime_error naming the file if it cannot be opened.
+std::unique_ptr<lcm::LogFile> open_lcm_log(const std::filesystem::path& path);
+/// The bytes of a logged message.
+std::span<const std::uint8_t> log_payload(const lcm::LogEvent& event);
+/// Once reading has stopped: LogFile stops at the first event it cannot read, so this warns, with
+/// the byte, if that was before the end of the file (truncated or corrupt).
+void report_unread_tail(lcm::LogFile& log, const std::filesystem::path& path);
 
 class LcmLogEventReader {
  public:
