@@ -8,14 +8,21 @@ trap 'rm -rf "$work"' EXIT
 "$1" --sizes 240x180 --repeats 1 --min-time-ms 1 --window-ms 50 --json "$work/bench.json" >"$work/out.txt"
 cat "$work/out.txt"
 grep -q '^240x180 *boxes-6dof' "$work/out.txt"
-for key in storage_mev_s receive_mev_s detect_hz track_hz pipeline_mev_s lattice_mb peak_rss_mb active_points lines_tracked; do
+for key in storage_mev_s receive_mev_s detect_hz track_hz filters_mev_s pipeline_mev_s lattice_mb peak_rss_mb active_points lines_tracked; do
   value=$(grep -oP "\"$key\": \K[0-9.e+-]+" "$work/bench.json")
   awk -v v="$value" 'BEGIN { exit !(v > 0) }' || { echo "FAILED: $key = '$value'"; exit 1; }
 done
+setup_ms=$(grep -oP '"filters_setup_ms": \{"unit": "ms", "median": \K[0-9.e+-]+' "$work/bench.json")
+awk -v v="$setup_ms" 'BEGIN { exit !(v > 0) }' || { echo "FAILED: filters_setup_ms = '$setup_ms'"; exit 1; }
 # Decoding speed: the same events in each of the five file formats, every one read whole.
 "$1" --decode --repeats 1 >"$work/decode.txt"
 cat "$work/decode.txt"
 [[ $(grep -cP '^sample\S* +2120987 events +[0-9.]+ Mev/s' "$work/decode.txt") -eq 5 ]] || { echo "FAILED: decode table"; exit 1; }
+# Another filter chain is timed when asked for, and an unknown one is refused by name.
+"$1" --sizes 240x180 --repeats 1 --min-time-ms 1 --window-ms 50 --filters refractory,hot-pixel >"$work/chain.txt"
+grep -q 'filters: refractory,hot-pixel$' "$work/chain.txt" || { echo "FAILED: chain not named"; exit 1; }
+if "$1" --sizes 240x180 --filters refractory,bogus 2>"$work/err.txt"; then echo "FAILED: bad filter accepted"; exit 1; fi
+grep -q "unknown filter 'bogus'" "$work/err.txt"
 # A wrong flag is refused with the flag named.
 if "$1" --sizes 123x45 2>"$work/err.txt"; then echo "FAILED: bad size accepted"; exit 1; fi
 grep -q -- '--sizes' "$work/err.txt"
