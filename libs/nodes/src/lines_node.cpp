@@ -178,6 +178,8 @@ void LinesNode::run(const std::atomic<bool>& stop) {
   // Started by this thread, the store thread shares its priority (raised above the rounds').
   std::thread storer([&] { store_loop(stop); });
   std::thread publisher([&] { publish_loop(stop); });
+  std::thread whole_lines;
+  if (options_.whole_lines) whole_lines = std::thread([&] { whole_line_loop(stop); });
   while (!stop.load()) {
     if (lcm_.handleTimeout(100) < 0 && !stop.load()) {
       spdlog::error("LCM receive failed; stopping");  // a stop signal interrupting the wait is not a failure
@@ -186,6 +188,7 @@ void LinesNode::run(const std::atomic<bool>& stop) {
   }
   storer.join();
   publisher.join();
+  if (whole_lines.joinable()) whole_lines.join();
   if (auto engine = this->engine()) engine->stop();
 }
 
@@ -287,39 +290,76 @@ bool LinesNode::publish_segments(bool heartbeat) {
   const double whole_hz = shedding ? std::min(options_.whole_lines_hz, options_.whole_lines_loaded_hz) : options_.whole_lines_hz;
   const Timestamp event_period_us = static_cast<Timestamp>(1e6 / whole_hz) - engine->config().schedule.track_period_us;
   const bool whole_due = now_steady >= next_whole_list_ &&
-                         (!joiner_ || engine != joined_engine_ || lattice_us < joiner_->last_time() ||
-                          lattice_us - joiner_->last_time() >= event_period_us);
+                         (engine != whole_engine_handed_ || lattice_us < whole_time_handed_ ||
+                          lattice_us - whole_time_handed_ >= event_period_us);
   if (options_.whole_lines && whole_due) {
     next_whole_list_ = now_steady + period_of(whole_hz) - period_of(options_.publish_hz);
-    publish_whole_lines(engine, lattice_us);
-    whole_lists_published_.fetch_add(1, std::memory_order_relaxed);
-    if (shedding) whole_lists_while_shedding_.fetch_add(1, std::memory_order_relaxed);
+    whole_engine_handed_ = engine;
+    whole_time_handed_ = lattice_us;
+    hand_over_whole_step(engine, shedding);
   }
   return true;
 }
 
-void LinesNode::publish_whole_lines(const std::shared_ptr<RealtimeEngine>& engine, Timestamp lattice_us) {
+void LinesNode::hand_over_whole_step(const std::shared_ptr<RealtimeEngine>& engine, bool shedding) {
+  {
+    std::lock_guard lock(whole_mutex_);
+    WholeLineStep& step = next_whole_step_;
+    step.engine = engine;
+    step.lines.assign(lines_.begin(), lines_.end());  // no allocation once as many lines were handed over
+    step.utime = list_msg_.utime;
+    step.t_us = list_msg_.t_us;
+    step.newest_batch_seq = list_msg_.newest_batch_seq;
+    step.newest_batch_utime = list_msg_.newest_batch_utime;
+    step.shedding = shedding;
+    whole_step_waiting_ = true;
+  }
+  whole_step_handed_.notify_one();
+}
+
+void LinesNode::whole_line_loop(const std::atomic<bool>& stop) {
+  name_this_thread("evldt-whole");
+  run_this_thread_as_round();
+  constexpr auto kLongestWait = std::chrono::milliseconds(100);  // the stop flag is checked this often
+  while (!stop.load()) {
+    {
+      std::unique_lock lock(whole_mutex_);
+      if (!whole_step_handed_.wait_for(lock, kLongestWait, [&] { return whole_step_waiting_; })) continue;
+      std::swap(whole_step_, next_whole_step_);  // the newest step; its buffers come back for the next
+      whole_step_waiting_ = false;
+    }
+    publish_whole_lines();
+    whole_lists_published_.fetch_add(1, std::memory_order_relaxed);
+    if (whole_step_.shedding) whole_lists_while_shedding_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+void LinesNode::publish_whole_lines() {
+  const WholeLineStep& step = whole_step_;
+  const RealtimeEngine& engine = *step.engine;
   // A new engine (camera restart, clock back) starts its whole lines afresh; ids go on, never repeated.
-  if (engine != joined_engine_ || (joiner_ && lattice_us < joiner_->last_time())) {
+  if (step.engine != joined_engine_ || (joiner_ && step.t_us < joiner_->last_time())) {
     if (joiner_) next_whole_id_ += joiner_->created();
-    joiner_.emplace(engine->geometry().block_size, engine->config().whole_lines, next_whole_id_);
-    joined_engine_ = engine;
-    const LatticeParams& lattice = engine->config().lattice;
+    joiner_.emplace(engine.geometry().block_size, engine.config().whole_lines, next_whole_id_);
+    joined_engine_ = step.engine;
+    const LatticeParams& lattice = engine.config().lattice;
     whole_view_.emplace(lattice.sensor, lattice.block_size, lattice.alpha);
   }
-  engine->copy_lattice(*whole_view_);  // the events gaps are checked against
-  joiner_->update(lattice_us, lines_, &*whole_view_);
+  engine.copy_lattice(*whole_view_);  // the events gaps are checked against
+  joiner_->update(step.t_us, step.lines, &*whole_view_);
   as_tracked_lines(joiner_->lines(), whole_);
   fill_segment_list(whole_, whole_msg_);
-  whole_msg_.utime = list_msg_.utime;
-  whole_msg_.epoch = list_msg_.epoch;
+  // The header of the segment list the step was made of.
+  const SensorSize sensor = engine.geometry().sensor;
+  whole_msg_.utime = step.utime;
+  whole_msg_.epoch = epoch_us_;
   whole_msg_.seq = whole_seq_++;
-  whole_msg_.source = list_msg_.source;
-  whole_msg_.width = list_msg_.width;
-  whole_msg_.height = list_msg_.height;
-  whole_msg_.t_us = list_msg_.t_us;
-  whole_msg_.newest_batch_seq = list_msg_.newest_batch_seq;
-  whole_msg_.newest_batch_utime = list_msg_.newest_batch_utime;
+  whole_msg_.source = options_.camera;
+  whole_msg_.width = static_cast<std::int16_t>(sensor.width);
+  whole_msg_.height = static_cast<std::int16_t>(sensor.height);
+  whole_msg_.t_us = step.t_us;
+  whole_msg_.newest_batch_seq = step.newest_batch_seq;
+  whole_msg_.newest_batch_utime = step.newest_batch_utime;
   lcm_.publish(whole_lines_channel_, &whole_msg_);
 }
 

@@ -95,7 +95,10 @@ class LinesNode {
   /// Publishes the lines if a round changed them since the last list, or if `heartbeat` is set;
   /// true if it sent a list.
   bool publish_segments(bool heartbeat);
-  void publish_whole_lines(const std::shared_ptr<RealtimeEngine>& engine, Timestamp lattice_us);
+  /// Hands the lines of the list just sent to the whole-line thread, replacing a step it has not begun.
+  void hand_over_whole_step(const std::shared_ptr<RealtimeEngine>& engine, bool shedding);
+  void whole_line_loop(const std::atomic<bool>& stop);
+  void publish_whole_lines();
   void publish_stats(double period_s);
   [[nodiscard]] std::shared_ptr<RealtimeEngine> engine() const;
 
@@ -132,6 +135,28 @@ class LinesNode {
   std::uint64_t published_version_ = 0;  ///< the engine's lines version in the last list
   std::shared_ptr<const RealtimeEngine> published_engine_;
   std::atomic<std::uint64_t> lists_published_{0};
+  std::chrono::steady_clock::time_point next_whole_list_{};
+  std::shared_ptr<const RealtimeEngine> whole_engine_handed_;  ///< of the last whole-line step handed over
+  Timestamp whole_time_handed_ = 0;                            ///< its lattice time
+  std::uint64_t shed_seen_ = 0;                          ///< batches shed when the publisher last looked
+  std::chrono::steady_clock::time_point last_shed_{};    ///< when it last saw that number grow
+
+  // A whole-line step runs on a thread of its own (3-4 ms at 1280x720 live, against a segment
+  // list's fraction of a millisecond), so that no segment list waits for one.
+  struct WholeLineStep {
+    std::shared_ptr<RealtimeEngine> engine;
+    std::vector<TrackedLine> lines;  ///< of a segment list, whose header fields the whole lines repeat
+    std::int64_t utime = 0, t_us = 0, newest_batch_seq = -1, newest_batch_utime = 0;
+    bool shedding = false;  ///< handed over at the lower rate
+  };
+  std::mutex whole_mutex_;  // guards the two members below
+  std::condition_variable whole_step_handed_;
+  WholeLineStep next_whole_step_;
+  bool whole_step_waiting_ = false;
+  std::atomic<std::uint64_t> whole_lists_published_{0}, whole_lists_while_shedding_{0};
+
+  // Whole-line thread only.
+  WholeLineStep whole_step_;
   std::optional<WholeLineTracker> joiner_;  ///< for the engine below (held, so a new one is told apart)
   std::shared_ptr<const RealtimeEngine> joined_engine_;
   std::optional<ScarfLattice> whole_view_;  ///< the joined engine's lattice as of the last whole-line step
@@ -139,10 +164,6 @@ class LinesNode {
   std::vector<TrackedLine> whole_;
   segment_list_t whole_msg_;
   std::int64_t whole_seq_ = 0;
-  std::chrono::steady_clock::time_point next_whole_list_{};
-  std::uint64_t shed_seen_ = 0;                          ///< batches shed when the publisher last looked
-  std::chrono::steady_clock::time_point last_shed_{};    ///< when it last saw that number grow
-  std::atomic<std::uint64_t> whole_lists_published_{0}, whole_lists_while_shedding_{0};
   LinesNodeTotals last_stats_;
   LatencySummary last_latency_;  ///< of the last statistics message, for the log line
 };
