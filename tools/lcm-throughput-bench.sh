@@ -9,8 +9,11 @@
 # the longest run covers, up to --scene-s, so the start-up is a small part of the score); then
 # the highest rate held: zero lost batches and p99 latency under --max-p99-ms (LCM queues up to
 # 4096 batches, so a lines service that falls behind shows as latency before it shows as loss).
+# --repeats N runs the speeds N times over, in turn (so a drift of the machine touches every speed
+# alike), and ends with the median of each figure per speed: one run of a busy scene varies by
+# tens of percent here.
 # Usage: tools/lcm-throughput-bench.sh [--scene NAME] [--scene-s S] [--seconds S] [--publish-hz HZ] [--speeds "1 2 4"]
-#                                      [--max-p99-ms MS] [--json FILE] [--build DIR] [--no-f]
+#                                      [--repeats N] [--max-p99-ms MS] [--json FILE] [--build DIR] [--no-f]
 #                                      [--lines-arg ARG]...  (passed to evldt-lines, e.g. --no-whole-lines)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -21,6 +24,7 @@ seconds=10
 publish_hz=1000
 speeds="0.05 0.1 0.25 0.5 1 1.25"
 max_p99_ms=5
+repeats=1
 json=
 lines_args=()
 score=true
@@ -31,15 +35,17 @@ while (($#)); do
     --seconds) seconds=$2; shift 2 ;;
     --publish-hz) publish_hz=$2; shift 2 ;;
     --speeds) speeds=$2; shift 2 ;;
+    --repeats) repeats=$2; shift 2 ;;
     --max-p99-ms) max_p99_ms=$2; shift 2 ;;
     --json) json=$2; shift 2 ;;
     --build) build=$2; shift 2 ;;
     --lines-arg) lines_args+=("$2"); shift 2 ;;
     --no-f) score=false; shift ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "lcm-throughput-bench.sh: unknown argument $1 (see --help)" >&2; exit 1 ;;
   esac
 done
+[[ $repeats =~ ^[1-9][0-9]*$ ]] || { echo "lcm-throughput-bench.sh: --repeats takes a positive whole number, got '$repeats'" >&2; exit 1; }
 camera=$build/services/evldt-camera/evldt-camera
 lines=$build/services/evldt-lines/evldt-lines
 sim=$build/tools/evldt-sim/evldt-sim
@@ -80,7 +86,10 @@ printf 'scene %s, %s s per speed, segment lists at %s Hz, %s, evldt-lines %s %s\
   "${sensor_args[*]}" "${lines_args[*]:-(defaults otherwise)}"
 printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %11s %7s\n' speed "Mev/s" "batches lost" "shed (events %)" "camera CPU" "lines CPU" threads "B/event" "latency ms" "settled p99" "F@1%"
 rows=()
+medians=()
 best=0
+for repeat in $(seq "$repeats"); do
+((repeats == 1)) || echo "run $repeat of $repeats"
 for speed in $speeds; do
   "$lines" --lcm-url "$url" --publish-hz "$publish_hz" --log-period-s 0 "${sensor_args[@]}" ${lines_args[@]+"${lines_args[@]}"} >"$work/lines.out" 2>"$work/lines.err" &
   lines_pid=$!
@@ -133,16 +142,35 @@ for speed in $speeds; do
   lines_pct=$(awk -v c="$lines_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
   threads=$(field "$work/lines.err" 'rounds on')
   printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %11s %7s\n' "$speed" "$rate" "$lost of $received" "$batches_shed ($shed_pct%)" "$camera_pct" "$lines_pct" "$threads" "$bytes" "$median / $p99" "${settled_p99:-n/a}" "$f"
-  rows+=("{\"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"batches_shed\": $batches_shed, \"events_shed\": $events_shed, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"threads\": $threads, \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99, \"latency_settled_p99_ms\": ${settled_p99:-null}, \"live_f_1pct\": $( [[ $f == n/a ]] && echo null || echo "$f")}")
+  echo "$speed ${lines_pct%\%} $shed_pct $p99 ${settled_p99:-nan} ${f/n\/a/nan} $lost" >>"$work/runs.txt"
+  rows+=("{\"repeat\": $repeat, \"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"batches_shed\": $batches_shed, \"events_shed\": $events_shed, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"threads\": $threads, \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99, \"latency_settled_p99_ms\": ${settled_p99:-null}, \"live_f_1pct\": $( [[ $f == n/a ]] && echo null || echo "$f")}")
   if [[ $lost == 0 ]] && awk -v r="$rate" -v b="$best" -v p="$p99" -v m="$max_p99_ms" 'BEGIN { exit !(r > b && p < m) }'; then
     best=$rate
   fi
 done
+done
+if ((repeats > 1)); then
+  printf '\nmedians over %s runs\n%-7s %11s %16s %10s %14s %7s %16s\n' "$repeats" speed "lines CPU" "shed (events %)" "p99 ms" "settled p99" "F@1%" "runs with loss"
+  medians=()
+  for speed in $speeds; do
+    # The median of each column of this speed's runs (nan: not measured).
+    read -r cpu shed p99 settled f lossy < <(awk -v sp="$speed" '$1 == sp { n++; for (c = 2; c <= 6; c++) v[c, n] = $c; lossy += ($7 != 0) }
+      END { for (c = 2; c <= 6; c++) { m = 0; for (i = 1; i <= n; i++) if (v[c, i] != "nan") x[++m] = v[c, i] + 0
+              for (i = 2; i <= m; i++) for (j = i; j > 1 && x[j - 1] > x[j]; j--) { t = x[j]; x[j] = x[j - 1]; x[j - 1] = t }
+              printf "%s ", m == 0 ? "nan" : (m % 2 ? x[(m + 1) / 2] : (x[m / 2] + x[m / 2 + 1]) / 2) }
+            print lossy + 0 }' "$work/runs.txt")
+    printf '%-7s %10s%% %15s%% %10s %14s %7s %16s\n' "$speed" "$cpu" "$shed" "$p99" "$settled" "$f" "$lossy of $repeats"
+    json_number() { [[ $1 == nan ]] && echo null || echo "$1"; }
+    medians+=("{\"speed\": $speed, \"lines_cpu_pct\": $cpu, \"shed_pct\": $shed, \"latency_p99_ms\": $p99, \"latency_settled_p99_ms\": $(json_number "$settled"), \"live_f_1pct\": $(json_number "$f"), \"runs_with_loss\": $lossy}")
+  done
+fi
 echo "highest event rate held for $seconds s with zero lost batches and p99 latency < $max_p99_ms ms: $best Mev/s"
 if [[ -n $json ]]; then
   {
-    echo "{\"scene\": \"$scene\", \"seconds\": $seconds, \"publish_hz\": $publish_hz, \"max_p99_ms\": $max_p99_ms, \"best_mev_s\": $best, \"runs\": ["
+    echo "{\"scene\": \"$scene\", \"seconds\": $seconds, \"publish_hz\": $publish_hz, \"max_p99_ms\": $max_p99_ms, \"repeats\": $repeats, \"best_mev_s\": $best, \"runs\": ["
     (IFS=,; echo "${rows[*]}")
+    echo "], \"medians\": ["
+    (IFS=,; echo "${medians[*]}")
     echo "]}"
   } >"$json"
   echo "wrote $json"
