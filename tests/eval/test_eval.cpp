@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "evldt/eval/accumulator.hpp"
-#include "evldt/eval/json.hpp"
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/eval/plots.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
@@ -502,41 +501,6 @@ TEST_F(PlotFiles, WriteFailureNamesThePath) {
     EXPECT_NE(std::string(e.what()).find(missing.string()), std::string::npos) << e.what();
   }
   EXPECT_THROW(write_pr_curve_png(missing, {}, "x"), std::runtime_error);
-}
-
-TEST(JsonWriter, WritesNestedValuesWithEscaping) {
-  std::ostringstream out;
-  JsonWriter json(out);
-  json.begin_object()
-      .field("name", "a \"quoted\"\\ line\n\x01")
-      .field("steps", 3)
-      .field("big", std::uint64_t{18446744073709551615u})
-      .field("f", 0.1)
-      .field("nan", std::nan(""))
-      .field("ok", true);
-  json.key("list").begin_array().value(-2).value(0.5).begin_object().end_object().end_array();
-  json.key("empty").begin_array().end_array();
-  json.end_object();
-  EXPECT_TRUE(json.done());
-  EXPECT_EQ(out.str(),
-            "{\n"
-            "  \"name\": \"a \\\"quoted\\\"\\\\ line\\n\\u0001\",\n"
-            "  \"steps\": 3,\n"
-            "  \"big\": 18446744073709551615,\n"
-            "  \"f\": 0.1,\n"
-            "  \"nan\": null,\n"
-            "  \"ok\": true,\n"
-            "  \"list\": [\n"
-            "    -2,\n"
-            "    0.5,\n"
-            "    {}\n"
-            "  ],\n"
-            "  \"empty\": []\n"
-            "}\n");
-  JsonWriter misuse(out);
-  misuse.begin_object();
-  EXPECT_THROW(misuse.value(1), std::logic_error);
-  EXPECT_THROW(misuse.end_array(), std::logic_error);
 }
 
 }  // namespace

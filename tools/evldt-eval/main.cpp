@@ -14,7 +14,7 @@
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/simulator_options.hpp"
 #include "evldt/eval/frame_ground_truth.hpp"
-#include "evldt/eval/json.hpp"
+#include "evldt/json/json_writer.hpp"
 #include "evldt/eval/plots.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/eval/whole_line_support.hpp"

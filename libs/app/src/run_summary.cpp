@@ -4,28 +4,9 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "evldt/json/json_writer.hpp"
+
 namespace evldt {
-
-namespace {
-
-std::string json_escape(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
-      out += buffer;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 void RunSummary::add_pipeline(const DeterministicPipeline& pipeline) {
   filters = format_filter_chain(pipeline.config().filters.chain);
@@ -85,8 +66,8 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
 void RunSummary::write_json(const std::filesystem::path& path) const {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot create " + path.string());
-  out << "{\n  \"input\": \"" << json_escape(input) << "\",\n";
-  out << "  \"input_error\": \"" << json_escape(input_error) << "\",\n";
+  out << "{\n  \"input\": " << json_quoted(input) << ",\n";
+  out << "  \"input_error\": " << json_quoted(input_error) << ",\n";
   out << "  \"events_read\": " << events_read << ",\n  \"events_stored\": " << counters.events << ",\n";
   out << "  \"dropped_off_sensor\": " << drops.off_sensor << ",\n  \"dropped_time_backwards\": " << drops.time_backwards << ",\n";
   out << "  \"clock_resets\": " << drops.clock_resets << ",\n";

@@ -4,6 +4,8 @@
 
 #include <array>
 
+#include "evldt/json/json_writer.hpp"
+
 namespace evldt {
 namespace {
 
@@ -45,15 +47,6 @@ std::string make_image_schema() {
       kTimeSchema);
 }
 
-/// Text in a JSON string (control characters dropped).
-std::string escaped(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) out += c;
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -100,7 +93,7 @@ std::string base64(std::span<const std::uint8_t> bytes) {
 }
 
 std::string compressed_image_json(std::uint64_t time_ns, const std::string& frame_id, std::span<const std::uint8_t> jpeg) {
-  return fmt::format(R"({{"timestamp": {}, "frame_id": "{}", "format": "jpeg", "data": "{}"}})", time_json(time_ns), escaped(frame_id), base64(jpeg));
+  return fmt::format(R"({{"timestamp": {}, "frame_id": {}, "format": "jpeg", "data": "{}"}})", time_json(time_ns), json_quoted(frame_id), base64(jpeg));
 }
 
 std::string image_annotations_json(std::uint64_t time_ns, std::span<const TrackedLine> lines, const AnnotationStyle& style, int scale) {
@@ -137,12 +130,12 @@ std::string image_annotations_json(std::uint64_t time_ns, std::span<const Tracke
 }
 
 std::string stats_json(std::uint64_t time_ns, const stats_t& stats) {
-  return fmt::format(R"({{"timestamp": {}, "service": "{}", "source": "{}", "events_in": {}, "event_rate": {:.1f}, "batches_received": {}, )"
+  return fmt::format(R"({{"timestamp": {}, "service": {}, "source": {}, "events_in": {}, "event_rate": {:.1f}, "batches_received": {}, )"
                      R"("batches_lost": {}, "batches_shed": {}, "events_shed": {}, "detect_hz": {:.1f}, "track_hz": {:.1f}, "live_lines": {}, )"
-                     R"("latency_median_ms": {:.2f}, "latency_p99_ms": {:.2f}, "filters": "{}", "masked_pixels": {}}})",
-                     time_json(time_ns), escaped(stats.service), escaped(stats.source), stats.events_in, stats.event_rate, stats.batches_received,
+                     R"("latency_median_ms": {:.2f}, "latency_p99_ms": {:.2f}, "filters": {}, "masked_pixels": {}}})",
+                     time_json(time_ns), json_quoted(stats.service), json_quoted(stats.source), stats.events_in, stats.event_rate, stats.batches_received,
                      stats.batches_lost, stats.batches_shed, stats.events_shed, stats.detect_hz, stats.track_hz, stats.live_lines,
-                     stats.latency_median_ms, stats.latency_p99_ms, escaped(stats.filters), stats.num_masked_pixels);
+                     stats.latency_median_ms, stats.latency_p99_ms, json_quoted(stats.filters), stats.num_masked_pixels);
 }
 
 }  // namespace evldt

@@ -9,6 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
+#include "evldt/json/json_writer.hpp"
+
 namespace evldt {
 namespace {
 
@@ -26,23 +28,6 @@ std::string escape_html(const std::string& text) {
   return out;
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      static constexpr char kHex[] = "0123456789abcdef";
-      out += "\\u00";
-      out += kHex[(c >> 4) & 0xF];
-      out += kHex[c & 0xF];
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 // The page: the picture, fetched again as soon as the last one is shown (a newer one, or 204 and a
 // short pause); the status and the layer buttons, every half second.
@@ -227,13 +212,13 @@ std::string WebView::status_json() const {
   const auto picture = newest();
   std::string json = "{\"picture\": " + std::to_string(picture ? picture->number : 0) + ", \"status\": [";
   if (picture) {
-    for (std::size_t i = 0; i < picture->status.size(); ++i) json += (i ? ", " : "") + json_string(picture->status[i]);
+    for (std::size_t i = 0; i < picture->status.size(); ++i) json += (i ? ", " : "") + json_quoted(picture->status[i]);
   }
   json += "], \"layers\": [";
   if (picture) {
     for (std::size_t i = 0; i < picture->layers.size(); ++i) {
       const WebLayer& layer = picture->layers[i];
-      json += std::string(i ? ", " : "") + "{\"key\": " + json_string(std::string(1, layer.key)) + ", \"name\": " + json_string(layer.name) +
+      json += std::string(i ? ", " : "") + "{\"key\": " + json_quoted(std::string(1, layer.key)) + ", \"name\": " + json_quoted(layer.name) +
               ", \"shown\": " + (layer.shown ? "true" : "false") + "}";
     }
   }

@@ -1,4 +1,4 @@
-#include "evldt/eval/json.hpp"
+#include "evldt/json/json_writer.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -6,6 +6,32 @@
 #include <string>
 
 namespace evldt {
+
+std::string json_quoted(std::string_view text) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(text.size() + 2);
+  out += '"';
+  for (const char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          out += "\\u00";
+          out += kHex[(c >> 4) & 0xf];
+          out += kHex[c & 0xf];
+        } else {
+          out += c;  // UTF-8 passes through unchanged
+        }
+    }
+  }
+  out += '"';
+  return out;
+}
 
 JsonWriter& JsonWriter::begin_object() {
   before_value();
@@ -111,35 +137,6 @@ void JsonWriter::newline_and_indent() {
   for (std::size_t i = 0; i < open_.size(); ++i) out_ << "  ";
 }
 
-void JsonWriter::write_string(std::string_view text) {
-  static constexpr char kHex[] = "0123456789abcdef";
-  out_ << '"';
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out_ << "\\\"";
-        break;
-      case '\\':
-        out_ << "\\\\";
-        break;
-      case '\n':
-        out_ << "\\n";
-        break;
-      case '\r':
-        out_ << "\\r";
-        break;
-      case '\t':
-        out_ << "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out_ << "\\u00" << kHex[(c >> 4) & 0xf] << kHex[c & 0xf];
-        } else {
-          out_ << c;  // UTF-8 passes through unchanged
-        }
-    }
-  }
-  out_ << '"';
-}
+void JsonWriter::write_string(std::string_view text) { out_ << json_quoted(text); }
 
 }  // namespace evldt

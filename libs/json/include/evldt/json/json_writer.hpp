@@ -1,13 +1,18 @@
 #pragma once
-// A minimal streaming JSON writer for evaluation reports: objects, arrays, numbers, strings.
+// JSON text: a minimal streaming writer (objects, arrays, numbers, strings) for reports, and the
+// one way evldt quotes a string in JSON, for the few messages built by hand.
 
 #include <concepts>
 #include <cstdint>
 #include <ostream>
+#include <string>
 #include <string_view>
 #include <vector>
 
 namespace evldt {
+
+/// `text` as a JSON string, in quotes: '"', '\\' and control characters escaped, UTF-8 unchanged.
+std::string json_quoted(std::string_view text);
 
 /// Writes indented JSON to a stream. Inside an object every value is preceded by key(); misuse
 /// (a key outside an object, a value without a key, unbalanced ends) throws std::logic_error.
