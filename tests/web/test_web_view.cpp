@@ -5,7 +5,9 @@
 #include <httplib.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <atomic>
 #include <stdexcept>
+#include <thread>
 
 #include "evldt/web/web_view.hpp"
 
@@ -114,6 +116,42 @@ TEST_F(WebViewTest, KeysOfTheLayersAreQueuedInOrderOthersRefused) {
   EXPECT_EQ(client.Post("/key/e", "", "text/plain")->status, 503);  // the viz is not taking them
   EXPECT_EQ(view.take_keys().size(), WebView::kMaxQueuedKeys);
   EXPECT_EQ(view.counts().keys, 2 + WebView::kMaxQueuedKeys);
+}
+
+// The viz reuses the picture before the newest once no browser holds it: browsers reading status
+// and pictures while it publishes must never see one being rewritten (run under ThreadSanitizer,
+// which reported the reuse of a picture a browser had read last without ordering).
+TEST_F(WebViewTest, BrowsersReadingWhileTheVizPublishesSeeWholePictures) {
+  std::atomic<bool> done{false};
+  std::atomic<int> answers{0}, torn{0};
+  const auto browse = [&] {
+    httplib::Client browser{"127.0.0.1", view.port()};
+    while (!done.load()) {
+      if (const auto status = browser.Get("/status.json"); status && status->status == 200) {
+        ++answers;
+        // Every picture's status lines are one number twice: a mix of two pictures is torn.
+        const std::string& body = status->body;
+        const auto first = body.find("\"n="), second = body.find("\"n=", first + 1);
+        if (first != std::string::npos &&
+            (second == std::string::npos || body.substr(first, body.find('"', first + 1) - first) !=
+                                                body.substr(second, body.find('"', second + 1) - second))) {
+          ++torn;
+        }
+      }
+      if (const auto picture = browser.Get("/picture.jpg"); picture && picture->status == 200) ++answers;
+    }
+  };
+  std::thread first(browse), second(browse);
+  for (int n = 0; n < 400 || answers.load() < 50; ++n) {
+    const std::string line = "n=" + std::to_string(n);
+    view.publish(picture_of(n % 256), {line, line}, layers());
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    ASSERT_LT(n, 200000) << "the browsers got no answers";
+  }
+  done = true;
+  first.join();
+  second.join();
+  EXPECT_EQ(torn.load(), 0);
 }
 
 TEST(WebView, APortInUseIsAnErrorNamingIt) {

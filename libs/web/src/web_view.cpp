@@ -191,8 +191,20 @@ WebViewCounts WebView::counts() const {
 }
 
 std::shared_ptr<const WebView::Picture> WebView::newest() const {
-  std::lock_guard lock(mutex_);
-  return newest_;
+  std::shared_ptr<Picture> held;
+  {
+    std::lock_guard lock(mutex_);
+    held = newest_;
+  }
+  if (!held) return nullptr;
+  // A browser gives its hold up under the lock: publish() reuses a picture once no browser holds
+  // it, and only a release under the same lock orders the browser's reads of it before that reuse's
+  // writes (seeing a reference count drop to one does not; ThreadSanitizer caught it).
+  const Picture* const picture = held.get();
+  return {picture, [this, held = std::move(held)](const Picture*) mutable {
+            std::lock_guard lock(mutex_);
+            held.reset();
+          }};
 }
 
 std::shared_ptr<const std::string> WebView::jpeg_of(const Picture& picture) {

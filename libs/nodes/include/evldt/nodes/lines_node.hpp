@@ -140,6 +140,8 @@ class LinesNode {
   Timestamp whole_time_handed_ = 0;                            ///< its lattice time
   std::uint64_t shed_seen_ = 0;                          ///< batches shed when the publisher last looked
   std::chrono::steady_clock::time_point last_shed_{};    ///< when it last saw that number grow
+  LinesNodeTotals last_stats_;
+  LatencySummary last_latency_;  ///< of the last statistics message, for the log line
 
   // A whole-line step runs on a thread of its own (3-4 ms at 1280x720 live, against a segment
   // list's fraction of a millisecond), so that no segment list waits for one.
@@ -149,8 +151,8 @@ class LinesNode {
     std::int64_t utime = 0, t_us = 0, newest_batch_seq = -1, newest_batch_utime = 0;
     bool shedding = false;  ///< handed over at the lower rate
   };
-  std::mutex whole_mutex_;  // guards the two members below
   std::condition_variable whole_step_handed_;
+  std::mutex whole_mutex_;  // guards the two members below
   WholeLineStep next_whole_step_;
   bool whole_step_waiting_ = false;
   std::atomic<std::uint64_t> whole_lists_published_{0}, whole_lists_while_shedding_{0};
@@ -164,8 +166,6 @@ class LinesNode {
   std::vector<TrackedLine> whole_;
   segment_list_t whole_msg_;
   std::int64_t whole_seq_ = 0;
-  LinesNodeTotals last_stats_;
-  LatencySummary last_latency_;  ///< of the last statistics message, for the log line
 };
 
 }  // namespace evldt

@@ -86,6 +86,7 @@ class WebView {
   };
   using Clock = std::chrono::steady_clock;
   void add_routes();
+  /// The newest picture, held by the caller until it drops the pointer (dropped under mutex_).
   [[nodiscard]] std::shared_ptr<const Picture> newest() const;
   /// The JPEG of `picture`, encoded once.
   [[nodiscard]] std::shared_ptr<const std::string> jpeg_of(const Picture& picture);
