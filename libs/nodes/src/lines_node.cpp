@@ -256,16 +256,8 @@ bool LinesNode::publish_segments(bool heartbeat) {
     std::lock_guard lock(mutex_);
     included = latency_.list_published(lattice_us, now);
   }
-  const SensorSize sensor = engine->geometry().sensor;
-  list_msg_.utime = now;
-  list_msg_.epoch = epoch_us_;
-  list_msg_.seq = list_seq_++;
-  list_msg_.source = options_.camera;
-  list_msg_.width = static_cast<std::int16_t>(sensor.width);
-  list_msg_.height = static_cast<std::int16_t>(sensor.height);
-  list_msg_.t_us = lattice_us;
-  list_msg_.newest_batch_seq = included.seq;
-  list_msg_.newest_batch_utime = included.utime;
+  const ListHeader header{now, lattice_us, included.seq, included.utime, engine->geometry().sensor};
+  fill_header(header, list_seq_++, list_msg_);
   if (lcm_.publish(lines_channel_, &list_msg_) == 0) lists_published_.fetch_add(1, std::memory_order_relaxed);
   // Whole lines at most at their rate in wall time (up to a publish period early, so at equal
   // rates they go with every segment list) and in event time (up to a tracking period early): a
@@ -296,21 +288,30 @@ bool LinesNode::publish_segments(bool heartbeat) {
     next_whole_list_ = now_steady + period_of(whole_hz) - period_of(options_.publish_hz);
     whole_engine_handed_ = engine;
     whole_time_handed_ = lattice_us;
-    hand_over_whole_step(engine, shedding);
+    hand_over_whole_step(engine, header, shedding);
   }
   return true;
 }
 
-void LinesNode::hand_over_whole_step(const std::shared_ptr<RealtimeEngine>& engine, bool shedding) {
+void LinesNode::fill_header(const ListHeader& header, std::int64_t seq, segment_list_t& msg) const {
+  msg.utime = header.utime;
+  msg.epoch = epoch_us_;
+  msg.seq = seq;
+  msg.source = options_.camera;
+  msg.width = static_cast<std::int16_t>(header.sensor.width);
+  msg.height = static_cast<std::int16_t>(header.sensor.height);
+  msg.t_us = header.t_us;
+  msg.newest_batch_seq = header.newest_batch_seq;
+  msg.newest_batch_utime = header.newest_batch_utime;
+}
+
+void LinesNode::hand_over_whole_step(const std::shared_ptr<RealtimeEngine>& engine, const ListHeader& header, bool shedding) {
   {
     std::lock_guard lock(whole_mutex_);
     WholeLineStep& step = next_whole_step_;
     step.engine = engine;
     step.lines.assign(lines_.begin(), lines_.end());  // no allocation once as many lines were handed over
-    step.utime = list_msg_.utime;
-    step.t_us = list_msg_.t_us;
-    step.newest_batch_seq = list_msg_.newest_batch_seq;
-    step.newest_batch_utime = list_msg_.newest_batch_utime;
+    step.header = header;
     step.shedding = shedding;
     whole_step_waiting_ = true;
   }
@@ -338,7 +339,7 @@ void LinesNode::publish_whole_lines() {
   const WholeLineStep& step = whole_step_;
   const RealtimeEngine& engine = *step.engine;
   // A new engine (camera restart, clock back) starts its whole lines afresh; ids go on, never repeated.
-  if (step.engine != joined_engine_ || (joiner_ && step.t_us < joiner_->last_time())) {
+  if (step.engine != joined_engine_ || (joiner_ && step.header.t_us < joiner_->last_time())) {
     if (joiner_) next_whole_id_ += joiner_->created();
     joiner_.emplace(engine.geometry().block_size, engine.config().whole_lines, next_whole_id_);
     joined_engine_ = step.engine;
@@ -346,20 +347,10 @@ void LinesNode::publish_whole_lines() {
     whole_view_.emplace(lattice.sensor, lattice.block_size, lattice.alpha);
   }
   engine.copy_lattice(*whole_view_);  // the events gaps are checked against
-  joiner_->update(step.t_us, step.lines, &*whole_view_);
+  joiner_->update(step.header.t_us, step.lines, &*whole_view_);
   as_tracked_lines(joiner_->lines(), whole_);
   fill_segment_list(whole_, whole_msg_);
-  // The header of the segment list the step was made of.
-  const SensorSize sensor = engine.geometry().sensor;
-  whole_msg_.utime = step.utime;
-  whole_msg_.epoch = epoch_us_;
-  whole_msg_.seq = whole_seq_++;
-  whole_msg_.source = options_.camera;
-  whole_msg_.width = static_cast<std::int16_t>(sensor.width);
-  whole_msg_.height = static_cast<std::int16_t>(sensor.height);
-  whole_msg_.t_us = step.t_us;
-  whole_msg_.newest_batch_seq = step.newest_batch_seq;
-  whole_msg_.newest_batch_utime = step.newest_batch_utime;
+  fill_header(step.header, whole_seq_++, whole_msg_);  // that of the segment list the step was made of
   lcm_.publish(whole_lines_channel_, &whole_msg_);
 }
 

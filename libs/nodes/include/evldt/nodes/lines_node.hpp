@@ -95,8 +95,16 @@ class LinesNode {
   /// Publishes the lines if a round changed them since the last list, or if `heartbeat` is set;
   /// true if it sent a list.
   bool publish_segments(bool heartbeat);
+  /// What a list says besides its lines: the same for a segment list and the whole lines made of it.
+  struct ListHeader {
+    std::int64_t utime = 0;  ///< the segment list's publish time
+    Timestamp t_us = 0;
+    std::int64_t newest_batch_seq = -1, newest_batch_utime = 0;
+    SensorSize sensor;
+  };
+  void fill_header(const ListHeader& header, std::int64_t seq, segment_list_t& msg) const;
   /// Hands the lines of the list just sent to the whole-line thread, replacing a step it has not begun.
-  void hand_over_whole_step(const std::shared_ptr<RealtimeEngine>& engine, bool shedding);
+  void hand_over_whole_step(const std::shared_ptr<RealtimeEngine>& engine, const ListHeader& header, bool shedding);
   void whole_line_loop(const std::atomic<bool>& stop);
   void publish_whole_lines();
   void publish_stats(double period_s);
@@ -147,8 +155,8 @@ class LinesNode {
   // list's fraction of a millisecond), so that no segment list waits for one.
   struct WholeLineStep {
     std::shared_ptr<RealtimeEngine> engine;
-    std::vector<TrackedLine> lines;  ///< of a segment list, whose header fields the whole lines repeat
-    std::int64_t utime = 0, t_us = 0, newest_batch_seq = -1, newest_batch_utime = 0;
+    std::vector<TrackedLine> lines;  ///< of a segment list, whose header the whole lines repeat
+    ListHeader header;
     bool shedding = false;  ///< handed over at the lower rate
   };
   std::condition_variable whole_step_handed_;
