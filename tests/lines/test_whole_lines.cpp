@@ -386,6 +386,24 @@ TEST(WholeLineTracker, ARememberedEndStaysOnlyWhileTheEventsRunToIt) {
   EXPECT_NEAR(left_max, 44.0f, 0.1f);
 }
 
+// ... and only as far as they go on: the right part of an edge whose segments dropped out over 4 b
+// is kept to where its events end (runs without events of up to b are passed over), not to where
+// its segments last reached (the events hold half of that stretch, which would do for a gap).
+TEST(WholeLineTracker, ARememberedEndIsKeptAsFarAsTheEventsGoOn) {
+  ScarfLattice events(SensorSize{128, 64}, kBlock, 2.0);
+  for (std::uint16_t x = 4; x <= 50; ++x) {
+    if (x < 40 || x > 45) events.insert(x, 20);  // a 6 px run without events, passed over
+  }
+  WholeLineTracker tracker(kBlock);
+  tracker.update(0, pieces_along(20, 4, 68, 1), &events);
+  tracker.update(10, pieces_along(20, 4, 36, 1), &events);
+  const WholeLine& line = tracker.lines().at(0);
+  EXPECT_NEAR(min_x(line), 4.0f, 0.1f);
+  // The last event at x 50 holds the line to within 1.5 px + 0.1 px per px beyond its segments of it.
+  EXPECT_GE(max_x(line), 50.0f);
+  EXPECT_LE(max_x(line), 50.0f + 1.5f + 0.1f * 18.0f);
+}
+
 TEST(WholeLineTracker, RejectsStepsOutOfOrderAndABadBlockSize) {
   WholeLineTracker tracker(kBlock);
   tracker.update(10, {});

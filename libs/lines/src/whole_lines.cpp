@@ -19,6 +19,11 @@ constexpr float kLooseJoin = 2.0f;  // hysteresis: bounds for segments that were
 // Of b: a line taking back its former segments fits its own direction to them once they span this
 // much (chosen on boxes-6dof and boxes-10s; 4 b did as well there and worse on flicker-lamps).
 constexpr float kOwnFitRatio = 2.0f;
+// Of b: a remembered end is kept only as far as the events along it go on, passing over runs
+// without events up to this long (a block segment's worth). Chosen over 0.5 and 0.7 b on the
+// built-in scenes (docs/whole-lines.md): an edge's events thin out towards its end, a gap between
+// two objects is longer.
+constexpr float kEndRunRatio = 1.0f;
 
 }  // namespace
 
@@ -57,34 +62,52 @@ bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float
   return bridged(end, end + (beyond_max > 0 ? gap : -gap) * line.direction);
 }
 
+bool WholeLineTracker::event_within(Point2 at, float radius) const {
+  const int block = events_->geometry().block_at(at.x(), at.y());
+  if (block < 0) return false;
+  // The block's extended region reaches b/2 beyond its active region: every event within b/2 of a
+  // point of the active region is among its entries.
+  const float r = std::min(radius, 0.5f * block_size_);
+  const float r_squared = r * r;
+  const BlockEntries entries = events_->entries(block);
+  for (const LatticeEntry e : entries.entries) {
+    const float dx = static_cast<float>(entries.pixel_x(e)) - at.x();
+    const float dy = static_cast<float>(entries.pixel_y(e)) - at.y();
+    if (dx * dx + dy * dy <= r_squared) return true;
+  }
+  return false;
+}
+
 bool WholeLineTracker::bridged(Point2 from, Point2 to, float spread) const {
   const float length = (to - from).norm();
   if (events_ == nullptr || !(length > params_.max_unsupported_gap_ratio * block_size_)) return true;
-  const LatticeGeometry& geometry = events_->geometry();
   const int samples = static_cast<int>(std::ceil(length));
   // Half of the samples 0..samples, rounded up; the loop ends as soon as the answer is known.
   const int needed = (samples + 2) / 2;
   int supported = 0;
   for (int i = 0; i <= samples && supported < needed && supported + (samples + 1 - i) >= needed; ++i) {
     const float along = static_cast<float>(i) / static_cast<float>(samples);
-    const Point2 at = from + (to - from) * along;
-    // The block's extended region reaches b/2 beyond its active region: every event within b/2 of a
-    // point of the active region is among its entries.
-    const float near = std::min(1.5f + spread * along * length, 0.5f * block_size_);
-    const float near_squared = near * near;
-    const int block = geometry.block_at(at.x(), at.y());
-    if (block < 0) continue;
-    const BlockEntries entries = events_->entries(block);
-    for (const LatticeEntry e : entries.entries) {
-      const float dx = static_cast<float>(entries.pixel_x(e)) - at.x();
-      const float dy = static_cast<float>(entries.pixel_y(e)) - at.y();
-      if (dx * dx + dy * dy <= near_squared) {
-        ++supported;
-        break;
-      }
-    }
+    if (event_within(from + (to - from) * along, 1.5f + spread * along * length)) ++supported;
   }
   return supported >= needed;
+}
+
+float WholeLineTracker::held_reach(Point2 from, Point2 to, float spread) const {
+  const float length = (to - from).norm();
+  if (events_ == nullptr) return length;
+  const float max_run = kEndRunRatio * block_size_;
+  const int samples = static_cast<int>(std::ceil(length));
+  float last_held = 0;
+  for (int i = 1; i <= samples; ++i) {
+    const float distance = length * static_cast<float>(i) / static_cast<float>(samples);
+    if (distance - last_held > max_run) break;
+    // Once events are found, a rest no longer than a run is passed over.
+    if (last_held > 0 && length - last_held <= max_run) return length;
+    // A pixel nearer `from` than the tolerance may be held by the segments' own events at `from`.
+    const float radius = 1.5f + spread * distance;
+    if (distance > radius && event_within(from + (to - from) * (distance / length), radius)) last_held = distance;
+  }
+  return last_held;
 }
 
 std::uint64_t WholeLineTracker::previous_owner(std::uint64_t segment_id) const {
@@ -169,17 +192,21 @@ void WholeLineTracker::continue_track(Track& track, const Cluster& cluster, std:
   const bool same_line = fits({next.point, next.direction, was_min, was_max}, was, 1.0f);
   const float reach = 0.5f * block_size_;
   const auto at = [&](float along) -> Point2 { return next.point + along * next.direction; };
-  const bool remember_min = same_line && next.t_min > was_min + reach && t - track.end_seen_us[0] <= params_.end_memory_us &&
-                            bridged(at(next.t_min), at(was_min), params_.extension_spread);
-  const bool remember_max = same_line && next.t_max < was_max - reach && t - track.end_seen_us[1] <= params_.end_memory_us &&
-                            bridged(at(next.t_max), at(was_max), params_.extension_spread);
-  if (remember_min) {
-    next.t_min = was_min;
+  // How far the end at `now` is kept out towards where it was, `before`.
+  const auto kept = [&](Timestamp end_seen_us, float now, float before) {
+    if (!same_line || !(std::abs(before - now) > reach) || t - end_seen_us > params_.end_memory_us) return 0.0f;
+    const float held = held_reach(at(now), at(before), params_.extension_spread);
+    return held > reach ? held : 0.0f;
+  };
+  const float kept_min = next.t_min > was_min ? kept(track.end_seen_us[0], next.t_min, was_min) : 0.0f;
+  const float kept_max = next.t_max < was_max ? kept(track.end_seen_us[1], next.t_max, was_max) : 0.0f;
+  if (kept_min > 0) {
+    next.t_min -= kept_min;
   } else {
     track.end_seen_us[0] = t;
   }
-  if (remember_max) {
-    next.t_max = was_max;
+  if (kept_max > 0) {
+    next.t_max += kept_max;
   } else {
     track.end_seen_us[1] = t;
   }

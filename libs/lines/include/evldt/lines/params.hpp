@@ -78,12 +78,13 @@ struct WholeLineParams {
   /// within 1.5 px. Collinear edges of separate objects are apart by a gap without events; one edge
   /// whose segment is missing somewhere is not.
   float max_unsupported_gap_ratio = 0.5f;
-  /// Where a line would reach beyond its segments (an end grown to a corner, an end remembered for
-  /// end_memory_us), it does so only as far as that stretch is held by events as a gap must be, with
-  /// a tolerance that grows from 1.5 px by this many px per px beyond the segments (the line's
-  /// direction is known only so well): two edges that only nearly meet make no corner, and an edge's
-  /// end that the events left is not kept. Ends past a corner are still drawn back to it. Chosen
-  /// over 0 and 0.05 on the built-in scenes (docs/whole-lines.md).
+  /// Where a line would reach beyond its segments, it does so only where events hold that stretch,
+  /// with a tolerance that grows from 1.5 px by this many px per px beyond the segments (the line's
+  /// direction is known only so well): an end grows to a corner only if the stretch is held as a gap
+  /// must be (two edges that only nearly meet make no corner; ends past a corner are still drawn back
+  /// to it), and an end remembered for end_memory_us is kept only as far as the events along it go
+  /// on (an edge's end that the events left is not kept). Chosen over 0 and 0.05 on the built-in
+  /// scenes (docs/whole-lines.md).
   float extension_spread = 0.1f;
 };
 

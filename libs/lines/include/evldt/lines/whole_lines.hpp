@@ -37,8 +37,8 @@ class WholeLineTracker {
   /// The segments left start new lines. An end its segments no longer reach stays where it was for
   /// end_memory_us. Steps must come in time order. With `events` (the lattice the segments were
   /// tracked on), a line reaches beyond its segments only where the lattice holds events along the
-  /// stretch: across a gap longer than max_unsupported_gap_ratio * b to a new segment, to a corner,
-  /// to a remembered end; without, on geometry alone.
+  /// stretch: across a gap longer than max_unsupported_gap_ratio * b to a new segment, to a corner;
+  /// towards a remembered end only as far as the events along it go on; without, on geometry alone.
   void update(Timestamp t, std::span<const TrackedLine> segments, const ScarfLattice* events = nullptr);
 
   /// The lines of the last step that are published: those holding segments now that reached
@@ -81,6 +81,12 @@ class WholeLineTracker {
   /// or half or more of its pixels have an event of the lattice within 1.5 px + spread * (distance
   /// from `from`).
   [[nodiscard]] bool bridged(Point2 from, Point2 to, float spread = 0) const;
+  /// How far from `from` towards `to` the events go on along the stretch: to the last pixel with an
+  /// event within 1.5 px + spread * (distance from `from`), or all of it if what is left after that
+  /// pixel is at most b long; runs of up to b without events are passed over. All of it without a lattice.
+  [[nodiscard]] float held_reach(Point2 from, Point2 to, float spread) const;
+  /// Whether the current lattice holds an event within `radius` (at most b/2) of `at`.
+  [[nodiscard]] bool event_within(Point2 at, float radius) const;
   /// The track key a segment belonged to at the last step, or 0.
   [[nodiscard]] std::uint64_t previous_owner(std::uint64_t segment_id) const;
   /// Adds segment `s` as a member of the last cluster and refits its direction and extent.
