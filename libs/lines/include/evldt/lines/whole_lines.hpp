@@ -81,9 +81,10 @@ class WholeLineTracker {
   /// or half or more of its pixels have an event of the lattice within 1.5 px + spread * (distance
   /// from `from`).
   [[nodiscard]] bool bridged(Point2 from, Point2 to, float spread = 0) const;
-  /// How far from `from` towards `to` the events go on along the stretch: to the last pixel with an
-  /// event within 1.5 px + spread * (distance from `from`), or all of it if what is left after that
-  /// pixel is at most b long; runs of up to b without events are passed over. All of it without a lattice.
+  /// How far from `from` towards `to` the events go on along the stretch: to the last pixel farther
+  /// from `from` than its tolerance with an event within it (1.5 px + spread * the distance), passing
+  /// over runs of up to b without one; all of it once what is left after such a pixel is at most b
+  /// long; 0 if there is none. All of it without a lattice.
   [[nodiscard]] float held_reach(Point2 from, Point2 to, float spread) const;
   /// Whether the current lattice holds an event within `radius` (at most b/2) of `at`.
   [[nodiscard]] bool event_within(Point2 at, float radius) const;
