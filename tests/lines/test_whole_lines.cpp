@@ -388,7 +388,8 @@ TEST(WholeLineTracker, ARememberedEndStaysOnlyWhileTheEventsRunToIt) {
 
 // ... and only as far as they go on: the right part of an edge whose segments dropped out over 4 b
 // is kept to where its events end (runs without events of up to b are passed over), not to where
-// its segments last reached (the events hold half of that stretch, which would do for a gap).
+// its segments last reached nor dropped (the rule for a gap, half of the stretch held or nothing,
+// would drop it: 16 of its 33 pixels are held).
 TEST(WholeLineTracker, ARememberedEndIsKeptAsFarAsTheEventsGoOn) {
   ScarfLattice events(SensorSize{128, 64}, kBlock, 2.0);
   for (std::uint16_t x = 4; x <= 50; ++x) {
