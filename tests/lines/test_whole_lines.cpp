@@ -277,6 +277,22 @@ TEST(WholeLineTracker, ALineLostForAMomentComesBackUnderItsIdButNotAfterKeepId) 
   EXPECT_NE(tracker.lines()[0].id, id);
 }
 
+// boxes-6dof (motion seed 18, 7.78 s): a line that had shrunk to one short segment waited; its old
+// geometry, stretched by a waiting line's loose bounds, fitted a published line's edge and took it,
+// and that line's id, from it.
+TEST(WholeLineTracker, AWaitingLineDoesNotTakeUpAnotherPublishedLinesEdge) {
+  WholeLineTracker tracker(kBlock);
+  // A along y = 20 (x 4-36); B along y = 26 (x 60-92), 6 px off A's line and 24 px beyond its end:
+  // outside the bounds of a join, within those a waiting line looks along.
+  tracker.update(0, pieces_along(20, 4, 36, 1) + pieces_along(26, 60, 92, 11));
+  ASSERT_EQ(tracker.lines().size(), 2u);
+  const std::uint64_t b_id = line_holding(tracker, 26).id;
+  tracker.update(10'000, pieces_along(26, 60, 92, 11));  // A's segments are gone: A waits
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.lines()[0].id, b_id);
+  EXPECT_EQ(tracker.lines()[0].segments, 4u);
+}
+
 TEST(WholeLineTracker, SegmentsJoinedAtTheLastStepStayJoinedThroughAWobble) {
   // Ids 1 and 2 along y = 20; then id 2 wobbles by 15 degrees (beyond the 12 of a first join, within
   // twice that for segments that were one line).

@@ -311,18 +311,20 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
 
   cluster_of_segment_.assign(n, kUnassigned);
   clusters_.clear();
-  track_of_cluster_.clear();
+  cluster_of_track_.assign(tracks_.size(), kNone);
   members_.clear();
   // Lines tracked so far, the first published first: it wins a contested segment and keeps its id.
-  for (std::size_t k = 0; k < tracks_.size(); ++k) {
+  // A line takes back its former segments (take_back) and, where it has none, looks along its last
+  // geometry for a free segment (look_along); then it grows.
+  const auto follow = [&](std::size_t k, bool take_back, bool look_along) {
     const Track& track = tracks_[k];
-    if (t - track.last_seen_us > params_.keep_id_us) continue;
+    if (t - track.last_seen_us > params_.keep_id_us || cluster_of_track_[k] != kNone) return;
     Cluster cluster;
     cluster.model = track.model;
     cluster.first_member = members_.size();
     auto it = std::lower_bound(owned_.begin(), owned_.end(), std::pair(track.key, std::uint32_t{0}),
                                [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (; it != owned_.end() && it->first == track.key; ++it) {
+    for (; take_back && it != owned_.end() && it->first == track.key; ++it) {
       // Its former segments are taken back along its last geometry until those taken back span
       // enough to fit a direction of their own: one tilted segment taken back first (the longest,
       // at a corner) would else steer the line off its edge and leave the rest, and with it the
@@ -335,14 +337,22 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
       }
     }
     if (members_.size() == cluster.first_member) {
-      const std::size_t found = first_fit_along(track.model, segments);
-      if (found == kNone) continue;  // waits, under its last geometry
+      const std::size_t found = look_along ? first_fit_along(track.model, segments) : kNone;
+      if (found == kNone) return;  // waits, under its last geometry
       add_member(cluster, static_cast<std::uint32_t>(found), segments);
     }
     grow(cluster, track.key, segments);
+    cluster_of_track_[k] = clusters_.size();
     clusters_.push_back(cluster);
-    track_of_cluster_.push_back(k);
-  }
+  };
+  // Published lines that take back segments go before those that wait: a waiting line looks for
+  // its edge among the segments no published line took, so its old geometry does not take up
+  // another published line's edge (and id with it). Lines not yet published come last.
+  const auto published_count = static_cast<std::size_t>(
+      std::find_if(tracks_.begin(), tracks_.end(), [](const Track& track) { return track.id == 0; }) - tracks_.begin());
+  for (std::size_t k = 0; k < published_count; ++k) follow(k, true, false);
+  for (std::size_t k = 0; k < published_count; ++k) follow(k, false, true);
+  for (std::size_t k = published_count; k < tracks_.size(); ++k) follow(k, true, true);
   // New lines from the segments left.
   for (const std::uint32_t seed : order_) {
     if (cluster_of_segment_[seed] != kUnassigned || !(segments[seed].segment.length() > 0)) continue;
@@ -353,7 +363,6 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     add_member(cluster, seed, segments);
     grow(cluster, owner_of_segment_[seed], segments);
     clusters_.push_back(cluster);
-    track_of_cluster_.push_back(kNone);
   }
 
   const auto members_of = [&](std::size_t c) {
@@ -366,12 +375,11 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     const std::size_t first = clusters_[c].first_member;
     for (std::size_t m = first; m < first + members_of(c); ++m) next_owner_.emplace_back(segments[members_[m]].id, key);
   };
-  std::size_t c = 0;
   for (std::size_t k = 0; k < tracks_.size(); ++k) {
     Track& track = tracks_[k];
-    if (c < clusters_.size() && track_of_cluster_[c] == k) {
+    if (const std::size_t c = cluster_of_track_[k]; c != kNone) {
       continue_track(track, clusters_[c], members_of(c), t);
-      take_ownership(c++, track.key);
+      take_ownership(c, track.key);
     } else if (track.id == 0 || t - track.last_seen_us > params_.keep_id_us) {
       continue;  // ended (a line never published has no id to keep)
     } else {
@@ -379,6 +387,8 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     }
     next_tracks_.push_back(track);
   }
+  // The clusters after the tracks' are new lines.
+  std::size_t c = std::count_if(cluster_of_track_.begin(), cluster_of_track_.end(), [](std::size_t x) { return x != kNone; });
   for (; c < clusters_.size(); ++c) {
     const Track track{.key = next_key_++, .model = clusters_[c].model, .first_seen_us = t, .last_seen_us = t,
                       .end_seen_us = {t, t}, .segments = members_of(c)};

@@ -33,7 +33,8 @@ class WholeLineTracker {
   /// One step. Each line tracked so far, the first published first, takes back the segments it held
   /// that still lie along it and grows along its edge over free segments (taking over a younger
   /// line's segments where they fit, which merges the two). A published line that finds none waits
-  /// keep_id_us under its last geometry and may take segments up again; one never published ends.
+  /// keep_id_us under its last geometry and may take segments up again, from those left by the
+  /// published lines that took theirs back; one never published ends.
   /// The segments left start new lines. An end its segments no longer reach stays where it was for
   /// end_memory_us. Steps must come in time order. With `events` (the lattice the segments were
   /// tracked on), a line reaches beyond its segments only where the lattice holds events along the
@@ -128,7 +129,7 @@ class WholeLineTracker {
   std::vector<std::uint64_t> owner_of_segment_;  ///< previous_owner() of each segment of this step
   std::vector<std::pair<std::uint64_t, std::uint32_t>> owned_;  ///< (former owner key, segment), by key then length
   std::vector<Cluster> clusters_;
-  std::vector<std::size_t> track_of_cluster_;  ///< index into tracks_, or npos for a new line
+  std::vector<std::size_t> cluster_of_track_;  ///< index into clusters_ of each of tracks_, or npos
   std::vector<Track> next_tracks_;
   std::vector<std::pair<std::uint64_t, std::uint64_t>> owner_;  ///< (segment id, track key) of the last step, sorted
   std::vector<std::pair<std::uint64_t, std::uint64_t>> next_owner_;
