@@ -293,6 +293,21 @@ TEST(WholeLineTracker, AWaitingLineDoesNotTakeUpAnotherPublishedLinesEdge) {
   EXPECT_EQ(tracker.lines()[0].segments, 4u);
 }
 
+TEST(WholeLineTracker, AWaitingLineTakesUpOnlySegmentsWithinAJoinsGapOfIt) {
+  WholeLineTracker tracker(kBlock);
+  tracker.update(0, pieces_along(20, 4, 36, 1));
+  const std::uint64_t id = tracker.lines()[0].id;
+  tracker.update(10'000, {});
+  // 24 px beyond its old end, farther than a join reaches (16 px): another edge, a new line, too
+  // short to be published.
+  tracker.update(20'000, pieces_along(20, 60, 76, 11));
+  EXPECT_TRUE(tracker.lines().empty());
+  // 12 px beyond it: its edge, taken up under its id.
+  tracker.update(30'000, pieces_along(20, 48, 64, 21));
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  EXPECT_EQ(tracker.lines()[0].id, id);
+}
+
 TEST(WholeLineTracker, SegmentsJoinedAtTheLastStepStayJoinedThroughAWobble) {
   // Ids 1 and 2 along y = 20; then id 2 wobbles by 15 degrees (beyond the 12 of a first join, within
   // twice that for segments that were one line).

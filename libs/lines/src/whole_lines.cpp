@@ -40,7 +40,7 @@ WholeLineTracker::WholeLineTracker(int block_size, const WholeLineParams& params
   if (block_size <= 0) throw std::invalid_argument("whole lines need a positive block size, got " + std::to_string(block_size));
 }
 
-bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float relax) const {
+bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float relax, float gap_relax) const {
   const Point2 along = segment.q1 - segment.q0;
   const float length = along.norm();
   if (!(length > 0)) return false;
@@ -54,9 +54,10 @@ bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float
   const float ta = a.dot(line.direction), tb = b.dot(line.direction);
   const float beyond_max = std::min(ta, tb) - line.t_max, before_min = line.t_min - std::max(ta, tb);
   const float gap = std::max({beyond_max, before_min, 0.0f});
-  if (gap > relax * params_.max_gap_ratio * block_size_) return false;
+  if (gap > gap_relax * params_.max_gap_ratio * block_size_) return false;
   // A segment that was this line's at the last step keeps its place without new evidence: the
-  // gap was crossed on evidence when it joined, and a line does not split for a step's missing events.
+  // gap was crossed on evidence when it joined, and a line does not split for a step's missing
+  // events. A waiting line has no ends of now to bridge from: its gap bound is what holds it.
   if (gap == 0 || relax > 1.0f) return true;
   const Point2 end = line.point + (beyond_max > 0 ? line.t_max : line.t_min) * line.direction;
   return bridged(end, end + (beyond_max > 0 ? gap : -gap) * line.direction);
@@ -162,7 +163,7 @@ void WholeLineTracker::grow(Cluster& cluster, std::uint64_t owner, std::span<con
         const std::uint32_t k = end_index / 2;
         if (cluster_of_segment_[k] != kUnassigned) return;
         const bool was_member = owner != kNoKey && owner_of_segment_[k] == owner;
-        if (fits(cluster.model, segments[k].segment, was_member ? kLooseJoin : 1.0f)) add_member(cluster, k, segments);
+        if (fits(cluster.model, segments[k].segment, was_member ? kLooseJoin : 1.0f, was_member ? kLooseJoin : 1.0f)) add_member(cluster, k, segments);
       });
     }
   }
@@ -176,7 +177,7 @@ std::size_t WholeLineTracker::first_fit_along(const LineModel& line, std::span<c
     const Point2 at = line.point + (line.t_min + length * static_cast<float>(i) / static_cast<float>(samples)) * line.direction;
     end_grid_.for_each_near(at, [&](std::uint32_t end_index) {
       const std::uint32_t k = end_index / 2;
-      if (found == kNone && cluster_of_segment_[k] == kUnassigned && fits(line, segments[k].segment, kLooseJoin)) found = k;
+      if (found == kNone && cluster_of_segment_[k] == kUnassigned && fits(line, segments[k].segment, kLooseJoin, 1.0f)) found = k;
     });
   }
   return found;
@@ -189,7 +190,7 @@ void WholeLineTracker::continue_track(Track& track, const Cluster& cluster, std:
   const float was_min = (was.q0 - next.point).dot(next.direction);
   const float was_max = (was.q1 - next.point).dot(next.direction);
   // Only while the line itself is where it was: a line that turned or moved has no ends to keep.
-  const bool same_line = fits({next.point, next.direction, was_min, was_max}, was, 1.0f);
+  const bool same_line = fits({next.point, next.direction, was_min, was_max}, was, 1.0f, 1.0f);
   const float reach = 0.5f * block_size_;
   const auto at = [&](float along) -> Point2 { return next.point + along * next.direction; };
   // How far the end at `now` is kept out towards where it was, `before`.
@@ -221,7 +222,7 @@ bool WholeLineTracker::shadowed(const Segment& segment) const {
     const float length = along.norm();
     if (!(length > 0)) return false;
     const Point2 direction = along / length;
-    if (!fits({line.segment.q0, direction, 0.0f, length}, segment, kLooseJoin)) return false;
+    if (!fits({line.segment.q0, direction, 0.0f, length}, segment, kLooseJoin, kLooseJoin)) return false;
     // ... and covers at least half of it.
     const float ta = (segment.q0 - line.segment.q0).dot(direction), tb = (segment.q1 - line.segment.q0).dot(direction);
     const float covered = std::min(std::max(ta, tb), length) - std::max(std::min(ta, tb), 0.0f);
@@ -332,7 +333,7 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
       const bool own_fit = members_.size() > cluster.first_member &&
                            cluster.model.t_max - cluster.model.t_min >= kOwnFitRatio * block_size_;
       if (cluster_of_segment_[it->second] == kUnassigned &&
-          fits(own_fit ? cluster.model : track.model, segments[it->second].segment, kLooseJoin)) {
+          fits(own_fit ? cluster.model : track.model, segments[it->second].segment, kLooseJoin, kLooseJoin)) {
         add_member(cluster, it->second, segments);
       }
     }

@@ -74,10 +74,12 @@ class WholeLineTracker {
     std::size_t first_member = 0;
   };
 
-  /// Whether `segment` lies along `line`: direction, both ends' offsets and the gap to its extent
-  /// within the bounds, times `relax` (2 for a segment that was part of this line at the last step:
-  /// hysteresis, a line does not split for a step's wobble).
-  [[nodiscard]] bool fits(const LineModel& line, const Segment& segment, float relax) const;
+  /// Whether `segment` lies along `line`: direction and both ends' offsets within the bounds times
+  /// `relax`, the gap to its extent within the gap bound times `gap_relax` (2 and 2 for a segment
+  /// that was part of this line at the last step: hysteresis, a line does not split for a step's
+  /// wobble; 2 and 1 where a waiting line looks for its edge, which may have moved across itself
+  /// while it waited, but a segment farther along than a join reaches is another edge's).
+  [[nodiscard]] bool fits(const LineModel& line, const Segment& segment, float relax, float gap_relax) const;
   /// Whether the stretch from `from` to `to` may be bridged: it is short, or no lattice was given,
   /// or half or more of its pixels have an event of the lattice within 1.5 px + spread * (distance
   /// from `from`).
@@ -96,8 +98,8 @@ class WholeLineTracker {
   /// Adds to the last cluster every free segment that fits it, searching the grid cells around its
   /// members' ends. owner: the key whose former segments fit loosely (0: none).
   void grow(Cluster& cluster, std::uint64_t owner, std::span<const TrackedLine> segments);
-  /// The first free segment (in grid order) that fits `line` within twice the bounds (it may have
-  /// moved while the line waited), searched along its extent, or npos.
+  /// The first free segment (in grid order) that fits `line` within twice the direction and offset
+  /// bounds and the gap bound (fits()), searched along its extent, or npos.
   [[nodiscard]] std::size_t first_fit_along(const LineModel& line, std::span<const TrackedLine> segments) const;
   /// Whether a line published at this step lies along `segment` (within twice the bounds) and covers
   /// half of it or more: a second line on its edge waits until it merges into it or outlives it.
