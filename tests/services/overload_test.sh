@@ -16,9 +16,11 @@ url="udpm://239.255.76.67:7714?ttl=0"
 budget_ms=20
 # The unhurried run's budget: a sanitizer build runs the service several times slower (ThreadSanitizer
 # 5-15x), beside other tests, so 20 ms is not within its means there; it must still shed nothing
-# systematically (a wrong clock estimate would shed whatever the budget).
+# systematically (a wrong clock estimate would shed whatever the budget). Under ThreadSanitizer the
+# first second after the first batch queues up to some 200 ms (p99 137-200 ms in failing runs, 16-23
+# ms after it; 100 ms failed 7 of 18 runs on 2026-12-05, the code of then and before alike).
 idle_budget_ms=$budget_ms
-grep -q '^EVLDT_SANITIZE:STRING=.' "$build/CMakeCache.txt" 2>/dev/null && idle_budget_ms=100
+grep -q '^EVLDT_SANITIZE:STRING=.' "$build/CMakeCache.txt" 2>/dev/null && idle_budget_ms=400
 
 run_camera() {  # run_camera OUT: boxes-6dof in real time, 3 s
   "$camera" --lcm-url "$url" --scene boxes-6dof --duration-s 3 -q >"$1" 2>&1

@@ -163,7 +163,8 @@ void WholeLineTracker::grow(Cluster& cluster, std::uint64_t owner, std::span<con
         const std::uint32_t k = end_index / 2;
         if (cluster_of_segment_[k] != kUnassigned) return;
         const bool was_member = owner != kNoKey && owner_of_segment_[k] == owner;
-        if (fits(cluster.model, segments[k].segment, was_member ? kLooseJoin : 1.0f, was_member ? kLooseJoin : 1.0f)) add_member(cluster, k, segments);
+        const float relax = was_member ? kLooseJoin : 1.0f;
+        if (fits(cluster.model, segments[k].segment, relax, relax)) add_member(cluster, k, segments);
       });
     }
   }
@@ -389,7 +390,8 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     next_tracks_.push_back(track);
   }
   // The clusters after the tracks' are new lines.
-  std::size_t c = std::count_if(cluster_of_track_.begin(), cluster_of_track_.end(), [](std::size_t x) { return x != kNone; });
+  auto c = static_cast<std::size_t>(
+      std::count_if(cluster_of_track_.begin(), cluster_of_track_.end(), [](std::size_t x) { return x != kNone; }));
   for (; c < clusters_.size(); ++c) {
     const Track track{.key = next_key_++, .model = clusters_[c].model, .first_seen_us = t, .last_seen_us = t,
                       .end_seen_us = {t, t}, .segments = members_of(c)};
