@@ -356,6 +356,7 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   for (std::size_t k = 0; k < published_count; ++k) follow(k, false, true);
   for (std::size_t k = published_count; k < tracks_.size(); ++k) follow(k, true, true);
   // New lines from the segments left.
+  const std::size_t first_new_cluster = clusters_.size();
   for (const std::uint32_t seed : order_) {
     if (cluster_of_segment_[seed] != kUnassigned || !(segments[seed].segment.length() > 0)) continue;
     const Segment& s = segments[seed].segment;
@@ -389,10 +390,7 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     }
     next_tracks_.push_back(track);
   }
-  // The clusters after the tracks' are new lines.
-  auto c = static_cast<std::size_t>(
-      std::count_if(cluster_of_track_.begin(), cluster_of_track_.end(), [](std::size_t x) { return x != kNone; }));
-  for (; c < clusters_.size(); ++c) {
+  for (std::size_t c = first_new_cluster; c < clusters_.size(); ++c) {
     const Track track{.key = next_key_++, .model = clusters_[c].model, .first_seen_us = t, .last_seen_us = t,
                       .end_seen_us = {t, t}, .segments = members_of(c)};
     take_ownership(c, track.key);
