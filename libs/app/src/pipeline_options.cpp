@@ -73,6 +73,9 @@ void PipelineOptions::add_to(CLI::App& app) {
       ->check(finite_number() & CLI::Range(0.0, 16.0));
   group->add_option("--whole-line-corner-min-angle", whole_corner_angle_, "... if they differ in direction by this much (degrees)")
       ->check(finite_number() & CLI::Range(0.0, 90.0));
+  group->add_option("--whole-line-event-reach", whole_event_reach_,
+                    "Whole lines: an end reaches along the events beyond its segments up to this many b (0: off)")
+      ->check(finite_number() & CLI::Range(0.0, 16.0));
   group->add_option("--multi-block-norm", multi_block_norm_, "r_e divisor for lines over k blocks: block (N) or union (k*N)")
       ->check(CLI::IsMember({"block", "union"}));
   group->add_option("--track-period-us", track_period_, "Deterministic mode: tracking period in event time")
@@ -136,6 +139,7 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
   if (whole_min_length_) config.whole_lines.min_length_ratio = *whole_min_length_;
   if (whole_corner_reach_) config.whole_lines.corner_reach_ratio = *whole_corner_reach_;
   if (whole_corner_angle_) config.whole_lines.corner_min_angle_deg = *whole_corner_angle_;
+  if (whole_event_reach_) config.whole_lines.event_reach_ratio = *whole_event_reach_;
   if (multi_block_norm_) {
     config.track.multi_block_norm = *multi_block_norm_ == "union" ? EffectiveRatioNorm::Union : EffectiveRatioNorm::Block;
   }

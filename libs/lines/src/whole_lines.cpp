@@ -24,6 +24,48 @@ constexpr float kOwnFitRatio = 2.0f;
 // built-in scenes (docs/whole-lines.md): an edge's events thin out towards its end, a gap between
 // two objects is longer.
 constexpr float kEndRunRatio = 1.0f;
+// Where a published line's end reaches along the events beyond its segments (events_reach), in px.
+// Chosen on the built-in scenes (docs/whole-lines.md): a radius of 1 px and runs of 2 px gained less
+// recall; without the side test or the share, the reach ran on through night-boxes' noise; without
+// the clearance, it ran on into the neighbouring lines of monitor-hd and tag-board.
+constexpr float kReachEventRadius = 1.5f;  // a pixel is held by an event this close ...
+constexpr float kReachSideOffset = 3.0f;   // ... unless events lie this far off the line on both sides too
+constexpr float kReachMaxRun = 3.0f;       // the reach ends after a run this long without a held pixel
+constexpr float kReachMinShare = 0.6f;     // it ends at a pixel only if this share of those passed are held
+constexpr float kReachClearance = 3.0f;    // it stops short of coming this close to another published line
+
+/// Where the ray from + u * direction (u >= 0) first comes within `radius` of segment s: the least u
+/// in the capsule around s (its rectangle and the discs at its ends), or `none` if the ray misses it.
+float first_approach(Point2 from, Point2 direction, const Segment& s, float radius, float none) {
+  float first = none;
+  for (const Point2& centre : {s.q0, s.q1}) {
+    const Point2 w = centre - from;
+    const float along = w.dot(direction), discriminant = along * along - (w.squaredNorm() - radius * radius);
+    if (discriminant < 0) continue;
+    const float root = std::sqrt(discriminant);
+    if (along + root >= 0) first = std::min(first, std::max(0.0f, along - root));
+  }
+  const float length = s.length();
+  if (!(length > 0)) return first;
+  const Point2 e = (s.q1 - s.q0) / length, n(-e.y(), e.x());
+  // The ray in the segment's frame, and the interval of u on it within the rectangle |t| <= radius,
+  // 0 <= s <= length (slab by slab).
+  float u_min = 0, u_max = std::numeric_limits<float>::infinity();
+  const auto slab = [&](float start, float rate, float low, float high) {
+    if (std::abs(rate) < 1e-9f) {
+      if (start < low || start > high) u_max = -1;
+      return;
+    }
+    const float a = (low - start) / rate, b = (high - start) / rate;
+    u_min = std::max(u_min, std::min(a, b));
+    u_max = std::min(u_max, std::max(a, b));
+  };
+  const Point2 w = from - s.q0;
+  slab(w.dot(e), direction.dot(e), 0, length);
+  slab(w.dot(n), direction.dot(n), -radius, radius);
+  if (u_min <= u_max) first = std::min(first, u_min);
+  return first;
+}
 
 }  // namespace
 
@@ -32,8 +74,7 @@ WholeLineTracker::WholeLineTracker(int block_size, const WholeLineParams& params
       params_(params),
       cell_size_(static_cast<float>(block_size) * std::max(1.0f, params.max_gap_ratio + params.max_offset_ratio)),
       min_cos_angle_(std::cos(params_.max_angle_deg * std::numbers::pi_v<float> / 180.0f)),
-      loose_cos_angle_(
-          std::cos(std::min(90.0f, kLooseJoin * params_.max_angle_deg) * std::numbers::pi_v<float> / 180.0f)),
+      loose_cos_angle_(std::cos(std::min(90.0f, params_.loose_angle_deg) * std::numbers::pi_v<float> / 180.0f)),
       first_id_(first_id),
       next_id_(first_id) {
   if (first_id == 0) throw std::invalid_argument("whole-line ids start above 0");
@@ -63,22 +104,6 @@ bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float
   return bridged(end, end + (beyond_max > 0 ? gap : -gap) * line.direction);
 }
 
-bool WholeLineTracker::event_within(Point2 at, float radius) const {
-  const int block = events_->geometry().block_at(at.x(), at.y());
-  if (block < 0) return false;
-  // The block's extended region reaches b/2 beyond its active region: every event within b/2 of a
-  // point of the active region is among its entries.
-  const float r = std::min(radius, 0.5f * block_size_);
-  const float r_squared = r * r;
-  const BlockEntries entries = events_->entries(block);
-  for (const LatticeEntry e : entries.entries) {
-    const float dx = static_cast<float>(entries.pixel_x(e)) - at.x();
-    const float dy = static_cast<float>(entries.pixel_y(e)) - at.y();
-    if (dx * dx + dy * dy <= r_squared) return true;
-  }
-  return false;
-}
-
 bool WholeLineTracker::bridged(Point2 from, Point2 to, float spread) const {
   const float length = (to - from).norm();
   if (events_ == nullptr || !(length > params_.max_unsupported_gap_ratio * block_size_)) return true;
@@ -88,7 +113,7 @@ bool WholeLineTracker::bridged(Point2 from, Point2 to, float spread) const {
   int supported = 0;
   for (int i = 0; i <= samples && supported < needed && supported + (samples + 1 - i) >= needed; ++i) {
     const float along = static_cast<float>(i) / static_cast<float>(samples);
-    if (event_within(from + (to - from) * along, 1.5f + spread * along * length)) ++supported;
+    if (event_pixels_.any_within(from + (to - from) * along, 1.5f + spread * along * length)) ++supported;
   }
   return supported >= needed;
 }
@@ -106,7 +131,7 @@ float WholeLineTracker::held_reach(Point2 from, Point2 to, float spread) const {
     if (last_held > 0 && length - last_held <= max_run) return length;
     // A pixel nearer `from` than the tolerance may be held by the segments' own events at `from`.
     const float radius = 1.5f + spread * distance;
-    if (distance > radius && event_within(from + (to - from) * (distance / length), radius)) last_held = distance;
+    if (distance > radius && event_pixels_.any_within(from + (to - from) * (distance / length), radius)) last_held = distance;
   }
   return last_held;
 }
@@ -231,6 +256,84 @@ bool WholeLineTracker::shadowed(const Segment& segment) const {
   });
 }
 
+float WholeLineTracker::events_reach(Point2 from, Point2 direction, float max_length) const {
+  const Point2 normal(-direction.y(), direction.x());
+  float reached = 0;
+  int held = 0;
+  for (int k = 1; k <= static_cast<int>(std::floor(max_length)); ++k) {
+    const auto distance = static_cast<float>(k);
+    if (distance - reached > kReachMaxRun) break;
+    const Point2 at = from + distance * direction;
+    if (!event_pixels_.any_within(at, kReachEventRadius)) continue;
+    if (event_pixels_.any_within(at + kReachSideOffset * normal, kReachEventRadius) &&
+        event_pixels_.any_within(at - kReachSideOffset * normal, kReachEventRadius)) {
+      continue;
+    }
+    ++held;
+    if (static_cast<float>(held) >= kReachMinShare * distance) reached = distance;
+  }
+  return reached;
+}
+
+void WholeLineTracker::reach_along_events() {
+  const float max_reach = params_.event_reach_ratio * block_size_;
+  if (events_ == nullptr || !(max_reach > 0) || published_.empty()) return;
+  // Points every b/2 along each line, in cells of b: every line within the clearance of a point of a
+  // stretch lies in the 3 x 3 cells around one of the stretch's points b/2 apart (for b >= 6).
+  const float spacing = 0.5f * block_size_;
+  line_samples_.clear();
+  line_of_sample_.clear();
+  for (std::uint32_t i = 0; i < published_.size(); ++i) {
+    const Segment& s = published_[i].segment;
+    const int steps = 1 + static_cast<int>(std::ceil(s.length() / spacing));
+    for (int k = 0; k <= steps; ++k) {
+      line_samples_.push_back(s.q0 + (s.q1 - s.q0) * (static_cast<float>(k) / static_cast<float>(steps)));
+      line_of_sample_.push_back(i);
+    }
+  }
+  line_grid_.build(block_size_, line_samples_);
+  // Where the stretch from `from` first comes within the clearance of another line (or beyond max_reach).
+  const auto clear_along = [&](std::uint32_t self, Point2 from, Point2 direction, float reach) {
+    nearby_lines_.clear();
+    const int queries = static_cast<int>(std::ceil(reach / spacing));
+    for (int k = 0; k <= queries; ++k) {
+      line_grid_.for_each_near(from + (static_cast<float>(k) * spacing) * direction, [&](std::uint32_t sample) {
+        if (line_of_sample_[sample] != self) nearby_lines_.push_back(line_of_sample_[sample]);
+      });
+    }
+    std::sort(nearby_lines_.begin(), nearby_lines_.end());
+    nearby_lines_.erase(std::unique(nearby_lines_.begin(), nearby_lines_.end()), nearby_lines_.end());
+    float clear = max_reach + 1;
+    for (const std::uint32_t other : nearby_lines_) {
+      clear = std::min(clear, first_approach(from, direction, published_[other].segment, kReachClearance, clear));
+    }
+    return clear;
+  };
+  reached_.clear();
+  for (std::uint32_t i = 0; i < published_.size(); ++i) {
+    Segment s = published_[i].segment;
+    const float length = s.length();
+    if (!(length > 0)) {
+      reached_.push_back(s);
+      continue;
+    }
+    const Point2 along = (s.q1 - s.q0) / length;
+    for (Point2* end : {&s.q1, &s.q0}) {
+      const Point2 from = *end, direction = end == &s.q1 ? along : Point2(-along);
+      float reach = events_reach(from, direction, max_reach);
+      // Only pixels short of where the stretch comes near another line: the walk to them alone ends
+      // where this one did if that is short of it (asked only of the ends that reach out at all).
+      if (reach > 0) {
+        const float clear = clear_along(i, from, direction, reach);
+        if (clear <= reach) reach = events_reach(from, direction, std::ceil(clear) - 1);
+      }
+      *end = from + reach * direction;
+    }
+    reached_.push_back(s);
+  }
+  for (std::uint32_t i = 0; i < published_.size(); ++i) published_[i].segment = reached_[i];
+}
+
 void WholeLineTracker::meet_at_corners() {
   const float reach = params_.corner_reach_ratio * block_size_;
   if (!(reach > 0) || published_.size() < 2) return;
@@ -283,6 +386,7 @@ void WholeLineTracker::meet_at_corners() {
 void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments, const ScarfLattice* events) {
   if (stepped_ && t < last_t_) throw std::invalid_argument("whole-line steps must come in time order");
   events_ = events;
+  event_pixels_.reset(events);
   stepped_ = true;
   last_t_ = t;
   const auto n = static_cast<std::uint32_t>(segments.size());
@@ -419,8 +523,10 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   std::sort(tracks_.begin(), tracks_.end(), [](const Track& a, const Track& b) {
     return std::tuple(a.id == 0, a.id, a.key) < std::tuple(b.id == 0, b.id, b.key);
   });
+  reach_along_events();
   meet_at_corners();
   events_ = nullptr;  // the caller's lattice is not kept past the step
+  event_pixels_.reset(nullptr);
 }
 
 void as_tracked_lines(std::span<const WholeLine> lines, std::vector<TrackedLine>& out) {

@@ -27,7 +27,8 @@ class PipelineOptions {
   std::optional<int> width_, height_, block_size_, fit_iterations_, threads_;
   std::optional<double> alpha_;
   std::optional<float> fit_threshold_, inlier_ratio_, max_bend_, perturbation_, reassociation_angle_, reassociation_offset_;
-  std::optional<float> whole_angle_, whole_offset_, whole_gap_, whole_min_length_, whole_corner_reach_, whole_corner_angle_;
+  std::optional<float> whole_angle_, whole_offset_, whole_gap_, whole_min_length_, whole_corner_reach_, whole_corner_angle_,
+      whole_event_reach_;
   std::optional<std::string> multi_block_norm_;
   std::optional<Timestamp> track_period_, detect_period_, bad_track_patience_, reassociation_window_,
       whole_keep_id_, whole_end_memory_;

@@ -59,11 +59,17 @@ struct ScheduleParams {
 };
 
 /// Joining block segments into whole lines (whole_lines.hpp). Chosen on boxes-10s: tighter joins
-/// (8 degrees, 0.3 b, 1 b) split true lines and halved IDF1 (0.115 against 0.315).
+/// (8 degrees, 0.3 b, 1 b) split true lines and halved IDF1 (0.115 against 0.315). The angle was
+/// 12 degrees until issue 27: the block segments along an edge that moves across itself tilt by up to
+/// 15-20 degrees either way (a fit across its band of events), and joined none of them.
 struct WholeLineParams {
-  float max_angle_deg = 12.0f;     ///< a segment joins a line whose direction is this close to its own
+  float max_angle_deg = 20.0f;     ///< a segment joins a line whose direction is this close to its own
   float max_offset_ratio = 0.6f;   ///< of b: both its ends within this of the line
   float max_gap_ratio = 2.0f;      ///< of b: and it overlaps the line's extent or is at most this far from it
+  /// A segment that was part of the line at the last step stays within this direction of it (and
+  /// twice the offset and gap bounds: a line does not split for a step's wobble); also the bound of a
+  /// waiting line looking for its edge, and of a second line along a published one.
+  float loose_angle_deg = 24.0f;
   Timestamp keep_id_us = 1'000'000;  ///< a line without segments for this long ends; before, it may take segments up again
   /// An end its segments no longer reach stays this long: a block segment at the end of an edge comes
   /// and goes with the events there, the edge does not.
@@ -86,6 +92,11 @@ struct WholeLineParams {
   /// on (an edge's end that the events left is not kept). Chosen over 0 and 0.05 on the built-in
   /// scenes (docs/whole-lines.md).
   float extension_spread = 0.1f;
+  /// of b: a published line's end is drawn out along the events beyond its segments up to this far
+  /// (the segments fall short of an edge's end where the block there holds a corner, or is not yet
+  /// detected): as far as a line of events goes on that is no wider band (of noise or a trail), up
+  /// to where it comes near another published line. 0: off.
+  float event_reach_ratio = 2.0f;
 };
 
 struct PipelineConfig {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "evldt/events/event.hpp"
+#include "evldt/lines/event_pixels.hpp"
 #include "evldt/lines/geometry.hpp"
 #include "evldt/lines/line_map.hpp"
 #include "evldt/lines/point_grid.hpp"
@@ -40,6 +41,8 @@ class WholeLineTracker {
   /// tracked on), a line reaches beyond its segments only where the lattice holds events along the
   /// stretch: across a gap longer than max_unsupported_gap_ratio * b to a new segment, to a corner;
   /// towards a remembered end only as far as the events along it go on; without, on geometry alone.
+  /// With it, a published line's ends are also drawn out along the events beyond them
+  /// (event_reach_ratio; what is published only, the line is tracked on its segments).
   void update(Timestamp t, std::span<const TrackedLine> segments, const ScarfLattice* events = nullptr);
 
   /// The lines of the last step that are published: those holding segments now that reached
@@ -89,8 +92,6 @@ class WholeLineTracker {
   /// over runs of up to b without one; all of it once what is left after such a pixel is at most b
   /// long; 0 if there is none. All of it without a lattice.
   [[nodiscard]] float held_reach(Point2 from, Point2 to, float spread) const;
-  /// Whether the current lattice holds an event within `radius` (at most b/2) of `at`.
-  [[nodiscard]] bool event_within(Point2 at, float radius) const;
   /// The track key a segment belonged to at the last step, or 0.
   [[nodiscard]] std::uint64_t previous_owner(std::uint64_t segment_id) const;
   /// Adds segment `s` as a member of the last cluster and refits its direction and extent.
@@ -104,6 +105,15 @@ class WholeLineTracker {
   /// Whether a line published at this step lies along `segment` (within twice the bounds) and covers
   /// half of it or more: a second line on its edge waits until it merges into it or outlives it.
   [[nodiscard]] bool shadowed(const Segment& segment) const;
+  /// Draws the ends of published lines out along the events beyond them (WholeLineParams::event_reach_ratio),
+  /// each from the lines as they were before any end moved.
+  void reach_along_events();
+  /// How far the events hold a line going on from `from` along unit `direction`, up to `max_length`:
+  /// to the last pixel by which the pixels held so far are kReachMinShare or more of those passed, a
+  /// pixel held where an event lies within kReachEventRadius of it but not also on both sides of it
+  /// kReachSideOffset off the line (a band of noise or of a trail, no edge); the reach ends after a
+  /// run of kReachMaxRun without a held pixel.
+  [[nodiscard]] float events_reach(Point2 from, Point2 direction, float max_length) const;
   /// Moves the ends of published lines that make a corner to the corner (WholeLineParams::corner_*).
   void meet_at_corners();
   /// `track` followed by cluster `c`: new geometry, remembered ends, times.
@@ -112,9 +122,10 @@ class WholeLineTracker {
   float block_size_;
   WholeLineParams params_;
   const ScarfLattice* events_ = nullptr;  ///< of the current update(), or none
+  mutable EventPixels event_pixels_;      ///< of events_: a cache, filled as the queries come
   float cell_size_;  ///< of the grid of segment ends
   float min_cos_angle_;
-  float loose_cos_angle_;
+  float loose_cos_angle_;  ///< of WholeLineParams::loose_angle_deg
   std::uint64_t first_id_;
   std::uint64_t next_id_;
   std::uint64_t next_key_ = 1;
@@ -142,6 +153,11 @@ class WholeLineTracker {
   };
   std::vector<Corner> corners_;
   std::vector<std::uint8_t> end_moved_;
+  std::vector<Point2> line_samples_;          ///< points along the published lines, for reach_along_events
+  std::vector<std::uint32_t> line_of_sample_;
+  PointGrid line_grid_;                       ///< of line_samples_
+  std::vector<std::uint32_t> nearby_lines_;
+  std::vector<Segment> reached_;
 };
 
 /// Whole lines as rows of the segment format (segment_csv.hpp): score = the number of block segments
