@@ -77,8 +77,9 @@ class WholeLineTracker {
     std::size_t first_member = 0;
   };
 
-  /// Whether `segment` lies along `line`: direction and both ends' offsets within the bounds times
-  /// `relax`, the gap to its extent within the gap bound times `gap_relax` (2 and 2 for a segment
+  /// Whether `segment` lies along `line`: both ends' offsets within the bound times `relax` and its
+  /// direction within max_angle_deg (loose_angle_deg where relax > 1), the gap to its extent within
+  /// the gap bound times `gap_relax` (2 and 2 for a segment
   /// that was part of this line at the last step: hysteresis, a line does not split for a step's
   /// wobble; 2 and 1 where a waiting line looks for its edge, which may have moved across itself
   /// while it waited, but a segment farther along than a join reaches is another edge's).
@@ -99,10 +100,10 @@ class WholeLineTracker {
   /// Adds to the last cluster every free segment that fits it, searching the grid cells around its
   /// members' ends. owner: the key whose former segments fit loosely (0: none).
   void grow(Cluster& cluster, std::uint64_t owner, std::span<const TrackedLine> segments);
-  /// The first free segment (in grid order) that fits `line` within twice the direction and offset
-  /// bounds and the gap bound (fits()), searched along its extent, or npos.
+  /// The first free segment (in grid order) that fits `line` within the loose angle, twice the offset
+  /// bound and the gap bound (fits()), searched along its extent, or npos.
   [[nodiscard]] std::size_t first_fit_along(const LineModel& line, std::span<const TrackedLine> segments) const;
-  /// Whether a line published at this step lies along `segment` (within twice the bounds) and covers
+  /// Whether a line published at this step lies along `segment` (within the loose bounds) and covers
   /// half of it or more: a second line on its edge waits until it merges into it or outlives it.
   [[nodiscard]] bool shadowed(const Segment& segment) const;
   /// Draws the ends of published lines out along the events beyond them (WholeLineParams::event_reach_ratio),
