@@ -14,10 +14,6 @@ namespace {
 constexpr std::size_t kInsertChunk = 8192;
 // Batches up to this size (an LCM datagram holds 7000 events) filter without growing a buffer.
 constexpr std::size_t kPreparedBatch = std::size_t{1} << 16;
-// Input that stops for this long (wall time) is a pause: the rounds then run on what is new
-// without waiting for a period of event time. Longer than a live camera's or a slow replay's gap
-// between batches, short enough that the last events of a stream are answered promptly.
-constexpr auto kInputPause = std::chrono::milliseconds(10);
 }  // namespace
 
 RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
@@ -32,6 +28,7 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
       tracker_(lattice_.geometry(), config.score, config.track, &pool_) {
   filtered_.reserve_touched(kPreparedBatch);
   if (config.schedule.shedding_period_factor < 1) throw std::invalid_argument("shedding_period_factor must be at least 1");
+  if (config.schedule.input_pause_ms < 1) throw std::invalid_argument("input_pause_ms must be at least 1");
 }
 
 RealtimeEngine::~RealtimeEngine() { stop(); }
@@ -125,7 +122,12 @@ void RealtimeEngine::shed(Timestamp until_us) {
   // No round is woken: nothing new was stored, and the next stored batch brings the time with it.
   std::lock_guard lock(lattice_mutex_);
   latest_event_us_ = std::max(latest_event_us_, until_us);
-  last_shed_us_ = until_us;
+  last_overload_us_ = until_us;
+}
+
+void RealtimeEngine::note_overload(Timestamp at_us) {
+  std::lock_guard lock(lattice_mutex_);
+  last_overload_us_ = std::max(last_overload_us_, at_us);
 }
 
 void RealtimeEngine::note_input(const EventBatch& input) {
@@ -138,6 +140,7 @@ void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic
                           Round round) {
   name_this_thread(thread_name);
   run_this_thread_as_round();
+  const auto input_pause = std::chrono::milliseconds(config_.schedule.input_pause_ms);
   std::uint64_t seen = 0;
   Timestamp next_due = std::numeric_limits<Timestamp>::min();
   for (;;) {
@@ -161,7 +164,7 @@ void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic
           continue;
         }
         const std::uint64_t received_before = events_received_;
-        if (!lattice_changed_.wait_for(lock, kInputPause, due) && events_received_ == received_before) {
+        if (!lattice_changed_.wait_for(lock, input_pause, due) && events_received_ == received_before) {
           paused = true;
           break;
         }
@@ -174,7 +177,7 @@ void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic
       // Between batches, or when the input paused, the copy is made here at once.
       if (!paused && storing_.load(std::memory_order_relaxed)) {
         state.view_wanted = true;
-        lattice_changed_.wait_for(lock, kInputPause, [&] { return stopping_ || state.view_ready; });
+        lattice_changed_.wait_for(lock, input_pause, [&] { return stopping_ || state.view_ready; });
         if (stopping_) return;
       }
       if (!state.view_ready) take_view(state);
@@ -182,7 +185,7 @@ void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic
       state.view_wanted = false;
       seen = state.view_seen;
       now = state.view_us;
-      shed_lately = last_shed_us_ != kNeverShed && now - last_shed_us_ < kSheddingMemoryUs;
+      shed_lately = last_overload_us_ != kNeverShed && now - last_overload_us_ < kSheddingMemoryUs;
     }
     // While batches are being shed the service is past its means: rounds further apart leave the CPU
     // to storage (at x1 on monitor-hd, a third fewer batches shed and F@1% up, docs/realtime.md).
@@ -191,6 +194,7 @@ void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic
       std::lock_guard lock(lines_mutex_);
       round(state.view, now, shed_lately);
       lines_time_us_ = std::max(lines_time_us_, now);
+      state.last_round_us.store(now, std::memory_order_relaxed);
       lines_version_.fetch_add(1, std::memory_order_release);
     }
     round_done_.notify_all();
@@ -239,6 +243,8 @@ EngineCounters RealtimeEngine::counters() const {
   c.detect_rounds = detect_rounds_.load(std::memory_order_relaxed);
   c.detect_rounds_without_bend_test = detect_rounds_without_bend_test_.load(std::memory_order_relaxed);
   c.track_rounds = track_rounds_.load(std::memory_order_relaxed);
+  c.detected_us = detect_.last_round_us.load(std::memory_order_relaxed);
+  c.tracked_us = track_.last_round_us.load(std::memory_order_relaxed);
   return c;
 }
 

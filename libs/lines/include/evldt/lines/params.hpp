@@ -56,6 +56,11 @@ struct ScheduleParams {
   /// apart. Chosen at x1 on monitor-hd (docs/realtime.md): 2 sheds a third as many batches as 1,
   /// 3 no fewer than 2 at a lower F@1%.
   int shedding_period_factor = 2;
+  /// The real-time engine: input that stops for this long (wall time) is a pause, after which the
+  /// rounds run on what is new without waiting for a period of event time. Longer than a live
+  /// camera's or a slow replay's gap between batches, short enough that a stream's last events are
+  /// answered promptly.
+  int input_pause_ms = 10;
 };
 
 /// Joining block segments into whole lines (whole_lines.hpp). Chosen on boxes-10s: tighter joins

@@ -5,7 +5,7 @@
 // the rounds follow the events: a stream replayed at a tenth of real time costs a tenth of the
 // rounds; while the caller sheds batches it cannot store in time, the rounds run
 // ScheduleParams::shedding_period_factor periods apart, leaving the CPU to storage, and detection
-// keeps new lines without the bend test (bend_test.hpp). Each loop works
+// keeps new lines without the bend test (bend_test.hpp); the same while it thins batches. Each loop works
 // on its own copy of the lattice, brought up to date before each round (by the storing thread when
 // the loop asks while a batch is being stored), so storage never waits for a pass, nor for a copy
 // by a preempted thread of lower priority, and a round always starts from the newest state: rounds
@@ -34,6 +34,8 @@ struct EngineCounters {
   std::uint64_t track_rounds = 0;
   std::uint64_t lines_created = 0;
   Timestamp latest_event_us = 0;
+  Timestamp detected_us = 0;  ///< event time of the lattice the last detection round ran on
+  Timestamp tracked_us = 0;   ///< event time of the lattice the last tracking round ran on
 };
 
 class RealtimeEngine {
@@ -50,6 +52,9 @@ class RealtimeEngine {
   void process(const EventBatch& batch);
   /// Events up to `until_us` were shed unstored (over the latency budget): event time still moves on.
   void shed(Timestamp until_us);
+  /// The service is past its means at event time `at_us` (it stored a batch thinned, or shed one):
+  /// the rounds run further apart for a while (ScheduleParams::shedding_period_factor).
+  void note_overload(Timestamp at_us);
 
   struct LinesState {
     Timestamp lattice_us = 0;   ///< event time of the lattice state the lines were last tracked or detected on
@@ -84,6 +89,7 @@ class RealtimeEngine {
     bool view_ready = false;   // storage did: the view holds the lattice as of view_seen / view_us
     std::uint64_t view_seen = 0;
     Timestamp view_us = 0;
+    std::atomic<Timestamp> last_round_us{0};  // event time of the view the last round ran on
   };
 
   void note_input(const EventBatch& input);  // under lattice_mutex_
@@ -106,7 +112,7 @@ class RealtimeEngine {
   static constexpr Timestamp kNeverShed = std::numeric_limits<Timestamp>::min();
   // Rounds stay further apart until this much event time has passed without a batch shed.
   static constexpr Timestamp kSheddingMemoryUs = 1'000'000;
-  Timestamp last_shed_us_ = kNeverShed;       // event time of the last batch shed; guarded by lattice_mutex_
+  Timestamp last_overload_us_ = kNeverShed;   // event time of the last batch shed or thinned; guarded by lattice_mutex_
   bool stopping_ = false;                     // guarded by lattice_mutex_
   std::atomic<bool> storing_{false};          // process() is running: a loop lets it copy the views
   LoopState detect_, track_;
