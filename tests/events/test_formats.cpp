@@ -411,10 +411,13 @@ TEST(EcdText, ConvertsDecimalSecondsToExactMicroseconds) {
       "0.9999995 7 8 1\n"   // the rounding carries into the seconds
       "   \t\n"
       "4294.967296123 65535 65535 0\n"
+      "  3.5 11 12 1 \t\n"              // blanks before and after
+      "3.6 0000000000013 007 0\n"        // leading zeros, past the plain line's nine digits
       "2.000001\t9  10 1";  // last line without '\n'
   const std::vector<Event> expected{{2, 1, 2, 1},         {1, 1, 2, 1},        {12'500'000, 3, 4, -1},
                                     {1'000'000, 0, 0, 1}, {3811, 5, 6, -1},    {1'000'000, 7, 8, 1},
-                                    {4'294'967'296, 65535, 65535, -1}, {2'000'001, 9, 10, 1}};
+                                    {4'294'967'296, 65535, 65535, -1}, {3'500'000, 11, 12, 1},
+                                    {3'600'000, 13, 7, -1}, {2'000'001, 9, 10, 1}};
   for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, text.size()}) {
     EXPECT_EQ(decode_in_chunks(EventFormat::EcdText, bytes_of(text), chunk), expected) << "chunk " << chunk;
   }
@@ -431,7 +434,9 @@ TEST(EcdText, WriterPrintsSecondsWithNineFractionDigits) {
 TEST(EcdText, MalformedLinesAreReportedAtTheirStartWithTheirNumber) {
   const std::string good = "0.1 1 2 1\n";  // 10 bytes
   for (const std::string bad : {"0.2 abc 3 0", "0.2 1 2", "0.2 1 2 2", "0.2 -1 2 1", "0.2 1 65536 1", "0.2 1 2 1 junk",
-                                "-0.2 1 2 1", "0.2e3 1 2 1", "0.2. 1 2 1", ". 1 2 1", "0,2 1 2 1"}) {
+                                "-0.2 1 2 1", "0.2e3 1 2 1", "0.2. 1 2 1", ". 1 2 1", "0,2 1 2 1", "0.2 1 2 10",
+                                "0.2 1 2 1x", "0.2 1 2 +1", "0.2 1 2 1 0", "0.2 1 0065536 1", "0. 1 2 1",
+                                "1234567890123 1 2 1"}) {
     SCOPED_TRACE(bad);
     EventBatch batch;
     const auto decoder = make_decoder(EventFormat::EcdText, "events.txt");

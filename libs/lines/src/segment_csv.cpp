@@ -1,7 +1,8 @@
 #include "evldt/lines/segment_csv.hpp"
 
 #include <algorithm>
-#include <cinttypes>
+#include <charconv>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -12,11 +13,26 @@ void SegmentCsvWriter::write_step(Timestamp t, std::span<const TrackedLine> line
   sorted_.clear();
   for (const TrackedLine& line : lines) sorted_.push_back(&line);
   std::sort(sorted_.begin(), sorted_.end(), [](const TrackedLine* a, const TrackedLine* b) { return a->id < b->id; });
+  // The row as printf's "%lld,%llu,%.3f,%.3f,%.3f,%.3f,%.4f,%s" writes it (std::to_chars with a
+  // precision is specified so), at a fifth of its cost: printf's float formatting was a tenth of a
+  // whole evldt-offline run on monitor-hd.
+  char row[512];  // room for any float in fixed notation (at most 45 characters) in each field
   for (const TrackedLine* line : sorted_) {
     const Segment& s = line->segment;
-    std::fprintf(output_.file(), "%" PRId64 ",%" PRIu64 ",%.3f,%.3f,%.3f,%.3f,%.4f,%s\n", t, line->id, static_cast<double>(s.q0.x()),
-                 static_cast<double>(s.q0.y()), static_cast<double>(s.q1.x()), static_cast<double>(s.q1.y()),
-                 static_cast<double>(line->score), status_name(line->status).data());
+    char* at = row;
+    char* const end = row + sizeof row;
+    const auto put = [&](auto value, auto... format) {
+      at = std::to_chars(at, end, value, format...).ptr;
+      *at++ = ',';
+    };
+    put(t);
+    put(line->id);
+    for (const float coordinate : {s.q0.x(), s.q0.y(), s.q1.x(), s.q1.y()}) put(static_cast<double>(coordinate), std::chars_format::fixed, 3);
+    put(static_cast<double>(line->score), std::chars_format::fixed, 4);
+    const std::string_view status = status_name(line->status);
+    at = std::copy(status.begin(), status.end(), at);
+    *at++ = '\n';
+    std::fwrite(row, 1, static_cast<std::size_t>(at - row), output_.file());
   }
   rows_ += sorted_.size();
 }
