@@ -4,7 +4,7 @@
 # lost, CPU use of each process, bytes per event on the wire and the latency from batch publish to
 # the segment list that includes it (median / p99, and p99 once settled: from 1 s after the first
 # batch, past the start's cold caches), the batches shed over evldt-lines' latency
-# budget, and the live F@1% (lcm-logger records the segment lists, evldt-eval scores them against
+# budget and those thinned below it (with the share of events not stored), and the live F@1% (lcm-logger records the segment lists, evldt-eval scores them against
 # the scene's ground truth over the event time the run covered: the recording is made as long as
 # the longest run covers, up to --scene-s, so the start-up is a small part of the score); then
 # the highest rate held: zero lost batches and p99 latency under --max-p99-ms (LCM queues up to
@@ -84,7 +84,7 @@ field() {  # field FILE REGEX: the first number after REGEX
 
 printf 'scene %s, %s s per speed, segment lists at %s Hz, %s, evldt-lines %s %s\n' "$scene" "$seconds" "$publish_hz" "$url" \
   "${sensor_args[*]}" "${lines_args[*]:-(defaults otherwise)}"
-printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %11s %7s\n' speed "Mev/s" "batches lost" "shed (events %)" "camera CPU" "lines CPU" threads "B/event" "latency ms" "settled p99" "F@1%"
+printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %11s %7s\n' speed "Mev/s" "batches lost" "shed/thinned (ev %)" "camera CPU" "lines CPU" threads "B/event" "latency ms" "settled p99" "F@1%"
 rows=()
 medians=()
 best=0
@@ -129,10 +129,12 @@ for speed in $speeds; do
   bytes=$(field "$work/camera.out" 'MB,')
   received=$(field "$work/lines.out" 'batches')
   lost=$(field "$work/lines.out" 'received,')
-  batches_shed=$(field "$work/lines.out" 'shed')
-  events_shed=$(field "$work/lines.out" 'shed +[0-9]+ batches,')
+  events_shed=$(field "$work/lines.out" 'shed')
+  batches_shed=$(field "$work/lines.out" 'not stored:')
+  batches_thinned=$(field "$work/lines.out" 'latency budget,')
   events_in=$(field "$work/lines.out" 'events')
   batches_shed=${batches_shed:-0}
+  batches_thinned=${batches_thinned:-0}
   events_shed=${events_shed:-0}
   shed_pct=$(awk -v s="$events_shed" -v r="${events_in:-0}" 'BEGIN { printf "%.1f", (s + r > 0) ? 100 * s / (s + r) : 0 }')
   median=$(field "$work/lines.out" 'median')
@@ -141,9 +143,9 @@ for speed in $speeds; do
   camera_pct=$(awk -v c="$camera_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
   lines_pct=$(awk -v c="$lines_cpu" -v w="$wall" 'BEGIN { printf "%.0f%%", 100 * c / w }')
   threads=$(field "$work/lines.err" 'rounds on')
-  printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %11s %7s\n' "$speed" "$rate" "$lost of $received" "$batches_shed ($shed_pct%)" "$camera_pct" "$lines_pct" "$threads" "$bytes" "$median / $p99" "${settled_p99:-n/a}" "$f"
+  printf '%-7s %10s %14s %18s %11s %11s %8s %10s %14s %11s %7s\n' "$speed" "$rate" "$lost of $received" "$batches_shed/$batches_thinned ($shed_pct%)" "$camera_pct" "$lines_pct" "$threads" "$bytes" "$median / $p99" "${settled_p99:-n/a}" "$f"
   echo "$speed ${lines_pct%\%} $shed_pct $p99 ${settled_p99:-nan} ${f/n\/a/nan} $lost" >>"$work/runs.txt"
-  rows+=("{\"repeat\": $repeat, \"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"batches_shed\": $batches_shed, \"events_shed\": $events_shed, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"threads\": $threads, \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99, \"latency_settled_p99_ms\": ${settled_p99:-null}, \"live_f_1pct\": $( [[ $f == n/a ]] && echo null || echo "$f")}")
+  rows+=("{\"repeat\": $repeat, \"speed\": $speed, \"mev_s\": $rate, \"batches_received\": $received, \"batches_lost\": $lost, \"batches_shed\": $batches_shed, \"batches_thinned\": $batches_thinned, \"events_shed\": $events_shed, \"camera_cpu\": \"$camera_pct\", \"lines_cpu\": \"$lines_pct\", \"threads\": $threads, \"bytes_per_event\": $bytes, \"latency_median_ms\": $median, \"latency_p99_ms\": $p99, \"latency_settled_p99_ms\": ${settled_p99:-null}, \"live_f_1pct\": $( [[ $f == n/a ]] && echo null || echo "$f")}")
   if [[ $lost == 0 ]] && awk -v r="$rate" -v b="$best" -v p="$p99" -v m="$max_p99_ms" 'BEGIN { exit !(r > b && p < m) }'; then
     best=$rate
   fi

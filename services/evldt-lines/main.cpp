@@ -29,9 +29,16 @@ int main(int argc, char** argv) {
       ->check(finite_number() & CLI::Range(0.1, 10000.0));
   app.add_option("--max-latency-ms", options.max_latency_ms,
                  "Latency budget: event batches that queued longer than this before they could be stored are shed "
-                 "whole, unstored (counted; their time still moves the rounds on). 0: never shed")
+                 "whole, unstored (counted; their time still moves the rounds on); with --overload thin, those that "
+                 "queued a quarter of it or more keep every 2nd to 4th event. 0: never shed nor thin")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.0, 3600000.0));
+  app.add_option("--overload", options.overload,
+                 "What a batch that queued meets: thin (a share of its events kept, evenly) or shed (only whole "
+                 "batches past the latency budget, unstored)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, OverloadPolicy>{{"thin", OverloadPolicy::Thin},
+                                                                                {"shed", OverloadPolicy::Shed}}))
+      ->default_str("thin");
   app.add_option("--stats-hz", options.stats_hz, "Statistics messages per second")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.01, 100.0));
@@ -72,7 +79,7 @@ int main(int argc, char** argv) {
     std::printf(
         "evldt-lines summary\n"
         "  batches   %llu received, %llu lost (sequence gaps), %llu late (%llu resyncs), %llu invalid messages, %llu camera restarts\n"
-        "  shed      %llu batches, %llu events: later than the %.0f ms latency budget, not stored\n"
+        "  shed      %llu events, not stored: %llu batches later than the %.0f ms latency budget, %llu thinned\n"
         "  events    %llu received, %llu stored, %llu dropped as invalid (%llu off sensor, %llu back in time), %llu clock resets\n"
         "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
         "  loops     %llu detection rounds (%llu while shedding, without the bend test), %llu tracking rounds\n"
@@ -82,8 +89,9 @@ int main(int argc, char** argv) {
         static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),
         static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.sequence.resyncs),
         static_cast<unsigned long long>(t.receiver.invalid_messages),
-        static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.receiver.batches_shed),
-        static_cast<unsigned long long>(t.receiver.events_shed), options.max_latency_ms,
+        static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.receiver.events_shed),
+        static_cast<unsigned long long>(t.receiver.batches_shed), options.max_latency_ms,
+        static_cast<unsigned long long>(t.receiver.batches_thinned),
         static_cast<unsigned long long>(t.events_received),
         static_cast<unsigned long long>(t.events_stored),
         static_cast<unsigned long long>(t.receiver.drops.total()), static_cast<unsigned long long>(t.receiver.drops.off_sensor),

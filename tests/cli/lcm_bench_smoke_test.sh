@@ -7,9 +7,9 @@ set -euo pipefail
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$1" --build "$2" --scene boxes-6dof --seconds 2 --speeds 1 --max-p99-ms 1000 --json "$work/lcm.json" | tee "$work/out.txt"
-grep -qP '^1 +0\.[0-9]+ +0 of [1-9][0-9]* +[0-9]+ \([0-9.]+%\) +[0-9]+% +[0-9]+% +[1-9][0-9]* +9\.[0-9]+ +[0-9.]+ / [0-9.]+ +[0-9.]+ +0\.[0-9]+$' "$work/out.txt"
+grep -qP '^1 +0\.[0-9]+ +0 of [1-9][0-9]* +[0-9]+/[0-9]+ \([0-9.]+%\) +[0-9]+% +[0-9]+% +[1-9][0-9]* +9\.[0-9]+ +[0-9.]+ / [0-9.]+ +[0-9.]+ +0\.[0-9]+$' "$work/out.txt"
 grep -qP '"batches_lost": 0,' "$work/lcm.json"
-grep -qP '"batches_shed": [0-9]+, "events_shed": [0-9]+,' "$work/lcm.json"
+grep -qP '"batches_shed": [0-9]+, "batches_thinned": [0-9]+, "events_shed": [0-9]+,' "$work/lcm.json"
 grep -qP '"latency_settled_p99_ms": [0-9.]+,' "$work/lcm.json"  # 2 s: a second of it settled
 grep -qP '"live_f_1pct": 0\.[0-9]*[1-9]' "$work/lcm.json"
 grep -qP '"threads": [1-9]' "$work/lcm.json"

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Bounded latency with the real processes over UDP multicast on loopback (ttl=0):
-#  1. A run well within the machine's means sheds nothing; its receiving and storing threads run 10
-#     nice steps above its rounds, LCM's socket reader real-time, and the camera 10 steps above
-#     normal (where the test may raise them: as root); waiting, before the stream and after it,
-#     costs no CPU.
+#  1. A run well within the machine's means sheds no batch and thins few; its receiving and storing
+#     threads run 10 nice steps above its rounds, LCM's socket reader real-time, and the camera 10
+#     steps above normal (where the test may raise them: as root); waiting, before the stream and
+#     after it, costs no CPU.
 #  2. A consumer slowed on purpose (evldt-lines stopped with SIGSTOP for 300 ms, twice) sheds the
-#     batches that queued past its latency budget, counts them apart from losses (summary and
-#     statistics messages), slows its whole lines meanwhile, loses none, and keeps the median latency of what it stored within the budget.
+#     batches that queued past its latency budget (thinning those below it), counts them apart from
+#     losses (summary and statistics messages), slows its whole lines meanwhile, loses none, and keeps
+#     the median latency of what it stored within the budget.
 # Usage: overload_test.sh BUILD_DIR SOURCE_DIR
 set -uo pipefail
 build=$1
@@ -73,7 +74,13 @@ check "evldt-lines after its stream ended is idle" mostly_idle "$lines_pid"
 kill -INT "$lines_pid"
 wait "$lines_pid"
 cat "$work/idle.out"
-check "an unhurried run sheds nothing (budget $idle_budget_ms ms)" grep -qP "shed +0 batches, 0 events" "$work/idle.out"
+check "an unhurried run sheds no batch (budget $idle_budget_ms ms)" grep -qP "not stored: 0 batches" "$work/idle.out"
+# Batches that queued a quarter of the budget are thinned: a loaded machine (the suite runs tests side
+# by side) may delay a few; a wrong clock estimate would thin every batch (half of its events or more).
+idle_events=$(field "$work/idle.out" 'events +')
+idle_thinned=$(field "$work/idle.out" 'shed')
+check "... and thins at most a few ($idle_thinned of $idle_events events not stored)" \
+  awk -v s="${idle_thinned:-1e9}" -v n="${idle_events:-0}" 'BEGIN { exit !(s <= 0.05 * n) }'
 check "... and loses nothing" grep -qP "batches +$batches received, 0 lost" "$work/idle.out"
 check "... and keeps whole lines at their full rate" grep -qP "whole-line lists \(0 at [0-9]+ Hz while shedding\)" "$work/idle.out"
 
@@ -97,7 +104,7 @@ sleep 1.5  # a statistics message after the last batch
 kill -INT "$lines_pid"
 wait "$lines_pid"
 cat "$work/slow.out"
-shed=$(field "$work/slow.out" 'shed')
+shed=$(field "$work/slow.out" 'not stored:')
 p99=$(grep -oP 'p99 \K[0-9.]+' "$work/slow.out" | head -1)
 check "the stalled evldt-lines shed batches that queued past ${budget_ms} ms ($shed)" test "${shed:-0}" -gt 0
 check "... counted apart from losses: none lost" grep -qP "batches +$batches received, 0 lost" "$work/slow.out"

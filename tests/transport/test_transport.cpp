@@ -623,19 +623,27 @@ TEST(SensorLag, MeasuresEachBatchBeyondTheQuickestAndTheClocksOffset) {
   EXPECT_NEAR(lag.clock_offset_s(), 1'000'000.003, 1e-9);
 }
 
-TEST(LatencyBudget, ShedsWhatQueuedPastTheBudgetWhateverTheSendersClock) {
+TEST(LatencyBudget, ThinsWhatQueuedAndShedsWhatQueuedPastTheBudgetWhateverTheSendersClock) {
   for (const std::int64_t offset : {std::int64_t{0}, std::int64_t{5'000'000}, std::int64_t{-3'000'000}}) {
     LatencyBudget budget(20);  // ms
     // Delivered in 0.3-0.5 ms; the sender's clock is `offset` behind ours.
     std::int64_t now = 10'000'000;
-    for (int i = 0; i < 100; ++i, now += 1000) EXPECT_FALSE(budget.late(now - offset - 300 - (i % 3) * 100, now)) << offset;
-    EXPECT_FALSE(budget.late(now - offset - 300 - 19'000, now));  // queued 19 ms: within
-    EXPECT_TRUE(budget.late(now - offset - 300 - 21'000, now));   // queued 21 ms: shed
+    for (int i = 0; i < 100; ++i, now += 1000) EXPECT_EQ(budget.stride(now - offset - 300 - (i % 3) * 100, now), 1) << offset;
+    EXPECT_EQ(budget.stride(now - offset - 300 - 4'900, now), 1);   // queued 4.9 ms: all of it kept
+    EXPECT_EQ(budget.stride(now - offset - 300 - 5'100, now), 2);   // past a quarter of the budget: every 2nd
+    EXPECT_EQ(budget.stride(now - offset - 300 - 12'000, now), 3);  // past half: every 3rd
+    EXPECT_EQ(budget.stride(now - offset - 300 - 19'000, now), 4);  // within the budget: every 4th
+    EXPECT_EQ(budget.stride(now - offset - 300 - 21'000, now), 0);  // queued 21 ms: shed whole
     EXPECT_NEAR(static_cast<double>(budget.last_queueing_us()), 21'000, 1);
   }
+  LatencyBudget shed_only(20, 2'000'000, OverloadPolicy::Shed);
+  std::int64_t now = 10'000'000;
+  EXPECT_EQ(shed_only.stride(now - 300, now), 1);
+  EXPECT_EQ(shed_only.stride(now - 300 - 19'000, now), 1);
+  EXPECT_EQ(shed_only.stride(now - 300 - 21'000, now), 0);
   LatencyBudget never(0);
-  EXPECT_FALSE(never.late(0, 10'000'000));
-  EXPECT_FALSE(never.late(1'000'000, 10'000'000));
+  EXPECT_EQ(never.stride(0, 10'000'000), 1);
+  EXPECT_EQ(never.stride(1'000'000, 10'000'000), 1);
   EXPECT_THROW(LatencyBudget(-1), std::invalid_argument);
 }
 
@@ -643,29 +651,29 @@ TEST(LatencyBudget, WhatQueuedWhileTheConsumerStartedIsNotLate) {
   LatencyBudget budget(20);
   std::int64_t now = 1'000'000;
   const std::int64_t offset = 2'000'000;  // the sender's clock is ahead of ours
-  EXPECT_FALSE(budget.late(now + offset - 400, now));  // the first batch: the consumer starts on it
+  EXPECT_EQ(budget.stride(now + offset - 400, now), 1);  // the first batch: the consumer starts on it
   // It takes 60 ms to start; 60 batches published meanwhile (one a millisecond) arrive together.
   now += 60'000;
   budget.ready_at(now);
-  for (std::int64_t k = 1; k <= 60; ++k) EXPECT_FALSE(budget.late(now + offset - 60'000 - 400 + k * 1000, now)) << k;
+  for (std::int64_t k = 1; k <= 60; ++k) EXPECT_EQ(budget.stride(now + offset - 60'000 - 400 + k * 1000, now), 1) << k;
   EXPECT_NEAR(static_cast<double>(budget.last_queueing_us()), 0, 1);  // the last of them queued briefly
   // After the start a stall is judged as ever.
   now += 30'000;
-  EXPECT_TRUE(budget.late(now + offset - 400 - 25'000, now));
-  EXPECT_FALSE(budget.late(now + offset - 400, now));
+  EXPECT_EQ(budget.stride(now + offset - 400 - 25'000, now), 0);
+  EXPECT_EQ(budget.stride(now + offset - 400, now), 1);
 }
 
 TEST(LatencyBudget, AClockStepIsForgottenWithinTwoWindows) {
   LatencyBudget budget(20, /*window_us=*/1'000'000);
   std::int64_t now = 0;
-  for (; now < 3'000'000; now += 1000) budget.late(now - 500, now);
+  for (; now < 3'000'000; now += 1000) budget.stride(now - 500, now);
   // The sender's clock steps 50 ms back: every batch now looks 50 ms old, then the estimate follows.
-  bool shed_late = false;
+  bool thinned_late = false;
   for (; now < 6'000'000; now += 1000) {
-    const bool late = budget.late(now - 500 - 50'000, now);
-    if (now >= 5'000'000) shed_late = shed_late || late;
+    const int stride = budget.stride(now - 500 - 50'000, now);
+    if (now >= 5'000'000) thinned_late = thinned_late || stride != 1;
   }
-  EXPECT_FALSE(shed_late);
+  EXPECT_FALSE(thinned_late);
 }
 
 TEST(EventBatchReceiver, ShedsLateBatchesUnreadButAccountsTheirSequence) {
@@ -698,6 +706,45 @@ TEST(EventBatchReceiver, ShedsLateBatchesUnreadButAccountsTheirSequence) {
   EXPECT_EQ(counts.batches_shed, 1u);
   EXPECT_EQ(counts.events_shed, 10u);
   EXPECT_EQ(counts.invalid_messages, 1u);
+}
+
+TEST(EventBatchReceiver, ThinsBatchesThatQueuedEvenlyKeepingTheirLastEvent) {
+  EventBatchReceiver receiver(std::nullopt, 0);
+  LatencyBudget budget(20);
+  EventBatch out;
+  const std::int64_t now = 50'000'000;
+  const auto batch_at = [](std::int64_t seq, std::int64_t utime, const EventBatch& events) {
+    event_batch_t msg = make_batch(events, seq);
+    msg.utime = utime;
+    return encode(msg);
+  };
+  const EventBatch ten = make_events(10, 0);
+  ASSERT_TRUE(receiver.receive(batch_at(0, now - 500, ten), out, budget, now));
+  EXPECT_FALSE(receiver.thinned());
+  EXPECT_EQ(out.size(), 10u);
+  // Queued 12 ms: every 3rd event, ending with the last (events 0, 3, 6 and 9 of its ten).
+  const EventBatch later = make_events(10, 100);
+  ASSERT_TRUE(receiver.receive(batch_at(1, now - 12'500, later), out, budget, now));
+  EXPECT_TRUE(receiver.thinned());
+  EXPECT_FALSE(receiver.shed());
+  ASSERT_EQ(out.size(), 4u);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const std::size_t i = 9 - 3 * (out.size() - 1 - k);
+    EXPECT_EQ(out.t[k], later.t[i]) << k;
+    EXPECT_EQ(out.x[k], later.x[i]) << k;
+    EXPECT_EQ(out.y[k], later.y[i]) << k;
+    EXPECT_EQ(out.p[k], later.p[i]) << k;
+  }
+  // Then all of the next, that did not queue.
+  ASSERT_TRUE(receiver.receive(batch_at(2, now - 400, make_events(10, 200)), out, budget, now));
+  EXPECT_FALSE(receiver.thinned());
+  EXPECT_EQ(out.size(), 10u);
+  const ReceiverCounts counts = receiver.counts();
+  EXPECT_EQ(counts.sequence.received, 3u);
+  EXPECT_EQ(counts.sequence.lost, 0u);
+  EXPECT_EQ(counts.batches_shed, 0u);
+  EXPECT_EQ(counts.batches_thinned, 1u);
+  EXPECT_EQ(counts.events_shed, 6u);
 }
 
 TEST(EventBatchReceiver, RefusesSensorSizesBeyondTheLimitOrThatTheSubscriberCannotUse) {

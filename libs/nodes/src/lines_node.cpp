@@ -17,7 +17,7 @@ constexpr std::size_t kMaxListedMaskedPixels = 4096;
 
 using Clock = std::chrono::steady_clock;
 
-// Whole lines stay at their lower rate until no batch has been shed for this long.
+// Whole lines stay at their lower rate until no batch has been shed or thinned for this long.
 constexpr std::chrono::seconds kSheddingMemory{1};
 
 // Batches queued between LCM's handler and the store thread: 80 ms of a 1280x720 stream at 20 Mev/s,
@@ -43,7 +43,7 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
                 [this](SensorSize size) {
                   return LatticeGeometry::fits(size, options_.configure(size).lattice.block_size);
                 }),
-      budget_(options_.max_latency_ms),
+      budget_(options_.max_latency_ms, 2'000'000, options_.overload),
       next_line_id_(static_cast<std::uint64_t>(epoch_us)),
       next_whole_id_(static_cast<std::uint64_t>(epoch_us)) {
   batch_.reserve_touched(1 << 16);
@@ -133,6 +133,13 @@ void LinesNode::store(std::span<const std::uint8_t> payload) {
     }
   } else if (accepted && !batch_.empty()) {
     engine_->process(batch_);
+    if (receiver_.thinned()) {
+      engine_->note_overload(batch_.t.back());
+      if (std::has_single_bit(receiver_.counts().batches_thinned)) {
+        spdlog::warn("thinned {} batch(es) that queued (latest {:.1f} ms): a share of their events stored, evenly",
+                     receiver_.counts().batches_thinned, static_cast<double>(budget_.last_queueing_us()) * 1e-3);
+      }
+    }
   }
   std::lock_guard lock(mutex_);
   receiver_counts_ = receiver_.counts();
@@ -262,18 +269,18 @@ bool LinesNode::publish_segments(bool heartbeat) {
   // Whole lines at most at their rate in wall time (up to a publish period early, so at equal
   // rates they go with every segment list) and in event time (up to a tracking period early): a
   // stream replayed slowly costs whole-line steps in proportion to its event time, as it does rounds.
-  // While batches are being shed, at their lower rate: the service is past its means, and the
-  // tracking rounds, whose lists the whole lines are built from, need the CPU first.
+  // While batches are being shed or thinned, at their lower rate: the service is past its means, and
+  // the tracking rounds, whose lists the whole lines are built from, need the CPU first.
   const auto now_steady = Clock::now();
   std::uint64_t shed;
   {
     std::lock_guard lock(mutex_);
-    shed = receiver_counts_.batches_shed;
+    shed = receiver_counts_.batches_shed + receiver_counts_.batches_thinned;
   }
   if (shed != shed_seen_) {
     if (options_.whole_lines && (shed_seen_ == 0 || now_steady - last_shed_ >= kSheddingMemory)) {
-      spdlog::info("shedding: whole lines at most {} Hz until no batch has been shed for {} s", options_.whole_lines_loaded_hz,
-                   std::chrono::duration<double>(kSheddingMemory).count());
+      spdlog::info("shedding: whole lines at most {} Hz until no batch has been shed or thinned for {} s",
+                   options_.whole_lines_loaded_hz, std::chrono::duration<double>(kSheddingMemory).count());
     }
     shed_seen_ = shed;
     last_shed_ = now_steady;

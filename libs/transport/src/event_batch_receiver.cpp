@@ -17,8 +17,13 @@ void EventBatchReceiver::refuse(const char* why) {
 }
 
 bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBatch& out) {
+  return receive_every(payload, out, 1);
+}
+
+bool EventBatchReceiver::receive_every(std::span<const std::uint8_t> payload, EventBatch& out, std::size_t stride) {
   shed_ = false;
-  if (const WireError error = decode_event_batch(payload, message_, out); error != WireError::None) {
+  thinned_ = false;
+  if (const WireError error = decode_event_batch(payload, message_, out, stride); error != WireError::None) {
     out.clear();
     refuse(error == WireError::WrongType ? "not an evldt event_batch_t" : "malformed event_batch_t");
     return false;
@@ -28,6 +33,11 @@ bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBat
     return false;
   }
   const std::uint64_t clock_resets_before = validator_->drops().clock_resets;
+  if (stride > 1) {
+    thinned_ = true;
+    ++batches_thinned_;
+    events_shed_ += static_cast<std::uint64_t>(message_.num_events) - out.size();
+  }
   validator_->filter(out);
   // A clock that went back is a restart for the subscriber as well: its state belongs to the old clock.
   if (validator_->drops().clock_resets != clock_resets_before) restarted_ = true;
@@ -40,9 +50,12 @@ bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBat
   if (decode_event_batch_header(payload, message_, last_event_us) != WireError::None) {
     return receive(payload, out);  // refused there, with its reason
   }
-  if (!budget.late(message_.utime, now_utime)) return receive(payload, out);
+  if (const int stride = budget.stride(message_.utime, now_utime); stride > 0) {
+    return receive_every(payload, out, static_cast<std::size_t>(stride));
+  }
   out.clear();
   shed_ = false;
+  thinned_ = false;
   if (!admit()) return false;
   shed_ = true;
   shed_until_us_ = last_event_us;
@@ -93,6 +106,7 @@ ReceiverCounts EventBatchReceiver::counts() const {
   counts.sequence = sequence_.counts();
   counts.drops = drops_before_restart_;
   counts.batches_shed = batches_shed_;
+  counts.batches_thinned = batches_thinned_;
   counts.events_shed = events_shed_;
   if (validator_) {
     counts.drops.off_sensor += validator_->drops().off_sensor;

@@ -6,14 +6,14 @@
 
 namespace evldt {
 
-LatencyBudget::LatencyBudget(double max_latency_ms, std::int64_t window_us)
-    : budget_us_(std::llround(max_latency_ms * 1e3)), window_us_(window_us) {
+LatencyBudget::LatencyBudget(double max_latency_ms, std::int64_t window_us, OverloadPolicy policy)
+    : budget_us_(std::llround(max_latency_ms * 1e3)), window_us_(window_us), policy_(policy) {
   if (!(max_latency_ms >= 0 && max_latency_ms <= 3.6e6) || window_us <= 0) {
     throw std::invalid_argument("the latency budget must be in 0 .. 3600000 ms and its window positive");
   }
 }
 
-bool LatencyBudget::late(std::int64_t publish_utime, std::int64_t now_utime) {
+int LatencyBudget::stride(std::int64_t publish_utime, std::int64_t now_utime) {
   const std::int64_t delay = now_utime - publish_utime;
   if (!started_ || now_utime - window_start_ >= window_us_ || now_utime < window_start_) {
     // A new window (or our clock stepped back): the one that ended becomes the previous.
@@ -24,8 +24,12 @@ bool LatencyBudget::late(std::int64_t publish_utime, std::int64_t now_utime) {
   }
   current_min_ = std::min(current_min_, delay);
   last_queueing_us_ = delay - std::min(current_min_, previous_min_);
-  if (exempt_ && publish_utime <= exempt_until_publish_) return false;
-  return budget_us_ > 0 && last_queueing_us_ > budget_us_;
+  if (budget_us_ <= 0 || (exempt_ && publish_utime <= exempt_until_publish_)) return 1;
+  if (last_queueing_us_ > budget_us_) return 0;
+  // 1 up to a quarter of the budget, then one more for each further quarter: 2, 3, 4.
+  if (policy_ == OverloadPolicy::Shed || last_queueing_us_ <= 0) return 1;
+  const std::int64_t step = std::max<std::int64_t>(budget_us_ / kThinningSteps, 1);
+  return static_cast<int>(std::min<std::int64_t>((last_queueing_us_ + step - 1) / step, kThinningSteps));
 }
 
 void LatencyBudget::ready_at(std::int64_t now_utime) {

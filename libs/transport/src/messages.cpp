@@ -5,6 +5,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace evldt {
 namespace {
@@ -226,23 +227,34 @@ WireError decode_event_batch_header_at(std::span<const std::uint8_t> bytes, even
   return WireError::None;
 }
 
-WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events) {
+WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events,
+                                  std::size_t stride) {
   const std::uint8_t* dt = nullptr;
   if (const WireError error = decode_event_batch_header_at(bytes, header, dt); error != WireError::None) return error;
   const auto n = static_cast<std::size_t>(header.num_events);
-  events.t.resize(n);
-  events.x.resize(n);
-  events.y.resize(n);
-  events.p.resize(n);
   const std::uint8_t* xs = dt + 4 * n;
   const std::uint8_t* ys = xs + 2 * n;
   const std::uint8_t* polarity = ys + 2 * n;
+  // Events first, first + stride, ..., n - 1: the last is always kept, so event time moves on alike.
+  const std::size_t kept = n == 0 ? 0 : (n - 1) / stride + 1;
+  const std::size_t first = n == 0 ? 0 : (n - 1) % stride;
+  events.t.resize(kept);
+  events.x.resize(kept);
+  events.y.resize(kept);
+  events.p.resize(kept);
   const Timestamp t_base = header.t_base_us;
-  for (std::size_t i = 0; i < n; ++i) events.t[i] = t_base + static_cast<std::int32_t>(get_be32(dt + 4 * i));
-  // Negative coordinates arrive as 32768..65535: off every sensor, so the validator drops them.
-  for (std::size_t i = 0; i < n; ++i) events.x[i] = get_be16(xs + 2 * i);
-  for (std::size_t i = 0; i < n; ++i) events.y[i] = get_be16(ys + 2 * i);
-  for (std::size_t i = 0; i < n; ++i) events.p[i] = polarity[i] ? std::int8_t{1} : std::int8_t{-1};
+  const auto decode = [&](auto step) {  // a constant step of 1 keeps the loops vectorised
+    for (std::size_t k = 0; k < kept; ++k) events.t[k] = t_base + static_cast<std::int32_t>(get_be32(dt + 4 * (first + k * step)));
+    // Negative coordinates arrive as 32768..65535: off every sensor, so the validator drops them.
+    for (std::size_t k = 0; k < kept; ++k) events.x[k] = get_be16(xs + 2 * (first + k * step));
+    for (std::size_t k = 0; k < kept; ++k) events.y[k] = get_be16(ys + 2 * (first + k * step));
+    for (std::size_t k = 0; k < kept; ++k) events.p[k] = polarity[first + k * step] ? std::int8_t{1} : std::int8_t{-1};
+  };
+  if (stride == 1) {
+    decode(std::integral_constant<std::size_t, 1>{});
+  } else {
+    decode(stride);
+  }
   return WireError::None;
 }
 
@@ -258,10 +270,12 @@ WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_b
   return WireError::None;
 }
 
-WireError decode_event_batch(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events) {
+WireError decode_event_batch(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events,
+                             std::size_t stride) {
+  if (stride == 0) throw std::invalid_argument("decode_event_batch: stride 0");
   // `events` is resized, not cleared first: the columns keep their size from the last batch, so
   // only growth beyond it pays for value-initialisation.
-  const WireError error = decode_event_batch_into(bytes, header, events);
+  const WireError error = decode_event_batch_into(bytes, header, events, stride);
   if (error != WireError::None) events.clear();
   return error;
 }

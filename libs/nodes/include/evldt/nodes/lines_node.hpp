@@ -37,8 +37,10 @@ struct LinesNodeOptions {
   std::function<PipelineConfig(SensorSize)> configure = default_config_for;
   Timestamp time_slack_us = 1000;
   double publish_hz = 100;  ///< at most this many segment lists a second: one after each round, when rounds are faster
-  /// Batches that queued longer than this before they could be stored are shed whole (0: never).
+  /// Batches that queued longer than this before they could be stored are shed whole (0: never);
+  /// below it, those that queued are thinned (LatencyBudget).
   double max_latency_ms = kDefaultMaxLatencyMs;
+  OverloadPolicy overload = OverloadPolicy::Thin;
   double stats_hz = 1;
   double log_period_s = 10;  ///< a status line in the log this often (0: never)
   bool whole_lines = true;   ///< also publish whole lines on WHOLE_LINES_<CAMERA>

@@ -20,7 +20,8 @@ struct ReceiverCounts {
   SequenceCounts sequence;
   DropCounts drops;                    ///< events refused by the validator (before a restart included)
   std::uint64_t batches_shed = 0;      ///< valid, current batches that came later than the latency budget
-  std::uint64_t events_shed = 0;       ///< their events, neither decoded nor validated
+  std::uint64_t batches_thinned = 0;   ///< valid, current batches that queued, of which only a share was decoded
+  std::uint64_t events_shed = 0;       ///< events of both not decoded nor validated (shed or thinned out)
 };
 
 class EventBatchReceiver {
@@ -36,9 +37,10 @@ class EventBatchReceiver {
   /// events and returns true (`out` may then be empty). A batch of a newer publisher epoch
   /// restarts the time-order check (restarted() tells).
   bool receive(std::span<const std::uint8_t> payload, EventBatch& out);
-  /// As receive(), but a valid, current batch that `budget` judges late at `now_utime` is shed: it
-  /// is accounted (sequence, sensor, counts) without decoding its events, `out` is left empty and
-  /// shed() tells. Shedding costs a header's parse, so a subscriber behind catches up at once.
+  /// As receive(), with the events of a valid, current batch that queued (as `budget` judges it at
+  /// `now_utime`) thinned: only every stride-th is decoded (thinned() tells); one that queued past
+  /// the budget is shed: accounted (sequence, sensor, counts) without decoding its events, `out` is
+  /// left empty and shed() tells. Both cost only what is kept, so a subscriber behind catches up.
   bool receive(std::span<const std::uint8_t> payload, EventBatch& out, LatencyBudget& budget, std::int64_t now_utime);
 
   /// Header of the last accepted batch (its arrays are empty: the events went to `out`).
@@ -50,10 +52,13 @@ class EventBatchReceiver {
   /// True if the last accepted batch was shed; shed_until_us() is then the time of its last event.
   [[nodiscard]] bool shed() const { return shed_; }
   [[nodiscard]] Timestamp shed_until_us() const { return shed_until_us_; }
+  /// True if only a share of the last accepted batch's events was decoded (it had queued).
+  [[nodiscard]] bool thinned() const { return thinned_; }
   [[nodiscard]] ReceiverCounts counts() const;
 
  private:
   void refuse(const char* why);
+  bool receive_every(std::span<const std::uint8_t> payload, EventBatch& out, std::size_t stride);
   /// The checks of a decoded header (sensor size, sequence); restarts the validator with the stream.
   bool admit();
 
@@ -67,8 +72,9 @@ class EventBatchReceiver {
   event_batch_t message_;
   bool restarted_ = false;
   bool shed_ = false;
+  bool thinned_ = false;
   Timestamp shed_until_us_ = 0;
-  std::uint64_t batches_shed_ = 0, events_shed_ = 0;
+  std::uint64_t batches_shed_ = 0, batches_thinned_ = 0, events_shed_ = 0;
 };
 
 }  // namespace evldt

@@ -1,7 +1,9 @@
 #pragma once
-// The latency budget of a live subscriber (DESIGN 9, bounded latency): an event batch that arrives
-// later than the budget is shed whole instead of queueing the ones behind it. The lattice keeps
-// only each block's newest events, so answers from a little less data beat answers a second old.
+// The latency budget of a live subscriber (DESIGN 9, bounded latency): a batch that queued is
+// thinned (every k-th event kept, k growing with the queueing), so that the events kept still span
+// all of its time and the whole sensor, and storage catches up at once; one that queued past the
+// budget is shed whole (the last resort: a stretch of time without events). The lattice keeps only
+// each block's newest events, so answers from a little less data beat answers a second old.
 //
 // Lateness is judged against the quickest delivery seen lately, not against the sender's clock
 // alone: a batch's delay from its publish (the sender's wall clock) to its arrival is transit plus
@@ -13,15 +15,25 @@
 
 namespace evldt {
 
+/// What a subscriber does with a batch that queued: keep every event but a share (thin), or only
+/// shed whole batches past the budget (the policy before thinning, for comparison).
+enum class OverloadPolicy : std::uint8_t { Thin, Shed };
+
 class LatencyBudget {
  public:
-  /// `max_latency_ms`: the queueing a batch may have met before it is shed; 0 never sheds.
-  /// `window_us`: how long the quickest delivery is remembered (the estimate spans one to two windows).
-  explicit LatencyBudget(double max_latency_ms, std::int64_t window_us = 2'000'000);
+  /// Batches that queued longer than a quarter of the budget keep every 2nd event, half of it every
+  /// 3rd, three quarters every 4th (OverloadPolicy::Thin).
+  static constexpr int kThinningSteps = 4;
 
-  /// A batch published at `publish_utime` (sender's clock) arrives at `now_utime` (ours): true if it
-  /// queued longer than the budget and should be shed. Every arrival refines the estimate.
-  bool late(std::int64_t publish_utime, std::int64_t now_utime);
+  /// `max_latency_ms`: the queueing a batch may have met before it is shed; 0 never sheds nor thins.
+  /// `window_us`: how long the quickest delivery is remembered (the estimate spans one to two windows).
+  explicit LatencyBudget(double max_latency_ms, std::int64_t window_us = 2'000'000,
+                         OverloadPolicy policy = OverloadPolicy::Thin);
+
+  /// A batch published at `publish_utime` (sender's clock) arrives at `now_utime` (ours): how much of
+  /// it to store, as every stride-th event: 1 all of it, 0 none (it queued longer than the budget:
+  /// shed it whole). Every arrival refines the estimate.
+  int stride(std::int64_t publish_utime, std::int64_t now_utime);
 
   /// The consumer was not ready until `now_utime` (ours): its store was being built. Batches
   /// published before then (as judged by the quickest delivery seen) are never late: they queued
@@ -36,6 +48,7 @@ class LatencyBudget {
  private:
   std::int64_t budget_us_;
   std::int64_t window_us_;
+  OverloadPolicy policy_;
   // The least delay of the current window and of the one before it; the estimate is their minimum.
   bool started_ = false;
   std::int64_t window_start_ = 0;

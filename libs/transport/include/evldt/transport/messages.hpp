@@ -40,7 +40,10 @@ void encode_event_batch(const event_batch_t& header, const EventBatch& events, s
 /// sets the scalar fields of `header` (its arrays are left empty) and appends the events, without
 /// building lcm-gen's arrays first. Coordinates and times are not judged here (the event validator
 /// drops and counts those); a time base out of range (negative or above 2^62) is Malformed.
-WireError decode_event_batch(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events);
+/// `stride` > 1 decodes every stride-th event only, ending with the last (a batch thinned under load:
+/// the events kept span its whole time), at the cost of those kept.
+WireError decode_event_batch(std::span<const std::uint8_t> bytes, event_batch_t& header, EventBatch& events,
+                             std::size_t stride = 1);
 
 /// Checks `bytes` as decode_event_batch does and sets the scalar fields of `header`, without decoding
 /// the events: `last_event_us` is the time of the batch's last event (its time base if it has none).
