@@ -4,11 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "evldt/media/media.hpp"
 
 namespace evldt {
 
@@ -114,7 +115,7 @@ cv::Mat blank_chart(const std::string& title) {
 void write_png(const std::filesystem::path& path, const cv::Mat& image) {
   bool written = false;
   try {
-    written = cv::imwrite(path.string(), image);
+    written = media::write_image(path.string(), image);
   } catch (const cv::Exception& e) {
     throw std::runtime_error("cannot write " + path.string() + ": " + e.what());
   }

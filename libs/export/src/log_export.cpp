@@ -2,13 +2,14 @@
 
 #include <cctype>
 #include <lcm/lcm-cpp.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // its constants; the calls go through evldt::media
 #include <optional>
 #include <stdexcept>
 
 #include "evldt/containers/mcap_writer.hpp"
 #include "evldt/export/foxglove_json.hpp"
 #include "evldt/lines/params.hpp"
+#include "evldt/media/media.hpp"
 #include "evldt/render/scene_renderer.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"
 #include "evldt/transport/channels.hpp"
@@ -89,7 +90,7 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
       next_image_us += period_us;
       if (next_image_us <= event->timestamp) next_image_us = event->timestamp + period_us;
       render_scene(*receiver.sensor(), lattice->surface(), {}, render, canvas);
-      cv::imencode(".jpg", canvas, jpeg, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
+      media::encode_image(".jpg", canvas, jpeg, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
       mcap.write(image_channel, time_ns, compressed_image_json(time_ns, counts.camera, jpeg));
       ++counts.images;
     } else if (event->channel == lines || event->channel == whole_lines) {

@@ -1,9 +1,8 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "evldt/frames/frame_writer.hpp"
+#include "evldt/media/media.hpp"
 
 namespace evldt {
 
@@ -16,7 +15,7 @@ EcdFrameWriter::EcdFrameWriter(const std::filesystem::path& folder) : folder_(fo
 void EcdFrameWriter::write(Timestamp t_us, const cv::Mat& grey) {
   char name[32];
   std::snprintf(name, sizeof name, "images/frame_%08d.png", written_);
-  if (!cv::imwrite((folder_ / name).string(), grey)) throw std::runtime_error((folder_ / name).string() + ": cannot write");
+  if (!media::write_image((folder_ / name).string(), grey)) throw std::runtime_error((folder_ / name).string() + ": cannot write");
   char line[64];
   std::snprintf(line, sizeof line, "%.6f %s\n", static_cast<double>(t_us) * 1e-6, name);
   list_ << line;

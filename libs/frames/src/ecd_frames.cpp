@@ -2,9 +2,10 @@
 #include <fstream>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // its constants; the calls go through evldt::media
 
 #include "evldt/frames/frame_reader.hpp"
+#include "evldt/media/media.hpp"
 
 namespace evldt {
 namespace {
@@ -37,7 +38,7 @@ class EcdFrameReader final : public FrameReader {
       }
       // Checked first: OpenCV would log its own warning for a missing file.
       if (!std::filesystem::is_regular_file(frame.name)) throw FrameError(where() + ": frame " + frame.name + " is missing");
-      frame.image = cv::imread(frame.name, cv::IMREAD_GRAYSCALE);
+      frame.image = media::read_image(frame.name, cv::IMREAD_GRAYSCALE);
       if (frame.image.empty()) throw FrameError(where() + ": frame " + frame.name + " is not an image");
       if (frame.image.cols != sensor_.width || frame.image.rows != sensor_.height) {
         throw FrameError(where() + ": frame " + frame.name + " is " + std::to_string(frame.image.cols) + "x" +

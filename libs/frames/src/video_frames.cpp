@@ -2,9 +2,10 @@
 // that LSD on them is a ground truth pixel-aligned with those events.
 
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
+#include <opencv2/videoio.hpp>  // its constants; the calls go through evldt::media
 
 #include "evldt/frames/frame_reader.hpp"
+#include "evldt/media/media.hpp"
 #include "video_frames.hpp"
 
 namespace evldt {
@@ -12,7 +13,7 @@ namespace {
 
 class VideoFrameReader final : public FrameReader {
  public:
-  VideoFrameReader(cv::VideoCapture capture, const std::filesystem::path& path, SensorSize sensor)
+  VideoFrameReader(media::VideoCapture capture, const std::filesystem::path& path, SensorSize sensor)
       : capture_(std::move(capture)), path_(path.string()), sensor_(sensor) {
     const double file_fps = capture_.get(cv::CAP_PROP_FPS);
     fps_ = file_fps > 0 && file_fps < 10000 ? file_fps : 30.0;
@@ -37,7 +38,7 @@ class VideoFrameReader final : public FrameReader {
   }
 
  private:
-  cv::VideoCapture capture_;
+  media::VideoCapture capture_;
   std::string path_;
   SensorSize sensor_;
   double fps_ = 30;
@@ -50,9 +51,9 @@ class VideoFrameReader final : public FrameReader {
 Timestamp video_frame_time_us(std::uint64_t index, double fps) { return static_cast<Timestamp>(static_cast<double>(index) * 1e6 / fps); }
 
 std::unique_ptr<FrameReader> open_video_frames(const std::filesystem::path& path, SensorSize sensor) {
-  cv::VideoCapture capture;
+  media::VideoCapture capture;
   // FFmpeg alone: the other backends would log their own errors for a file that is no video.
-  if (!capture.open(path.string(), cv::CAP_FFMPEG) || !capture.isOpened()) return nullptr;
+  if (!capture.open(path.string(), cv::CAP_FFMPEG)) return nullptr;
   return std::make_unique<VideoFrameReader>(std::move(capture), path, sensor);
 }
 

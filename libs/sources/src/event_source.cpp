@@ -4,7 +4,7 @@
 #include <charconv>
 #include <chrono>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
+#include <opencv2/videoio.hpp>  // its constants; the calls go through evldt::media
 #include <bit>
 #include <stdexcept>
 #include <thread>
@@ -14,6 +14,7 @@
 #include "evldt/containers/packet_source.hpp"
 #include "evldt/events/event_stream_reader.hpp"
 #include "evldt/frames/frame_reader.hpp"
+#include "evldt/media/media.hpp"
 #include <spdlog/spdlog.h>
 #include "evldt/transport/lcm_log.hpp"
 
@@ -198,7 +199,7 @@ class VideoSource final : public EventSource {
     const auto& input = options.input;
     const auto [end, error] = std::from_chars(input.data(), input.data() + input.size(), index);
     live_ = error == std::errc() && end == input.data() + input.size();
-    const bool opened = live_ ? capture_.open(index) : capture_.open(input);
+    const bool opened = live_ ? capture_.open(index) : capture_.open(input, cv::CAP_ANY);
     if (!opened) throw std::runtime_error("cannot open video " + std::string(live_ ? "camera " : "file ") + input);
     if (!live_) frame_count_ = capture_.get(cv::CAP_PROP_FRAME_COUNT);
     const double file_fps = capture_.get(cv::CAP_PROP_FPS);
@@ -246,7 +247,7 @@ class VideoSource final : public EventSource {
                          out ? *out : discard);
   }
 
-  cv::VideoCapture capture_;
+  media::VideoCapture capture_;
   bool live_ = false;
   double fps_ = 30;
   double frame_count_ = 0;

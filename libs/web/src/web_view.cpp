@@ -6,10 +6,11 @@
 #include <atomic>
 #include <charconv>
 #include <httplib.h>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // its constants; the calls go through evldt::media
 #include <stdexcept>
 
 #include "evldt/json/json_writer.hpp"
+#include "evldt/media/media.hpp"
 
 namespace evldt {
 namespace {
@@ -211,7 +212,7 @@ std::shared_ptr<const std::string> WebView::jpeg_of(const Picture& picture) {
   std::lock_guard lock(encode_mutex_);
   if (encoded_number_ != picture.number || !encoded_) {
     std::vector<std::uint8_t> bytes;
-    cv::imencode(".jpg", picture.bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality});
+    media::encode_image(".jpg", picture.bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality});
     encoded_ = std::make_shared<const std::string>(bytes.begin(), bytes.end());
     encoded_number_ = picture.number;
     std::lock_guard counts_lock(mutex_);

@@ -3,7 +3,8 @@
 
 #include <filesystem>
 #include <opencv2/core.hpp>
-#include <opencv2/videoio.hpp>
+
+#include "evldt/media/media.hpp"
 
 namespace evldt {
 
@@ -12,13 +13,13 @@ class FrameWriter {
   /// Either path may be empty (not written). Throws std::runtime_error if the video cannot be opened
   /// or the directory created.
   FrameWriter(const std::filesystem::path& video, const std::filesystem::path& frames_dir, double fps, cv::Size size);
-  [[nodiscard]] bool enabled() const { return video_.isOpened() || !frames_dir_.empty(); }
+  [[nodiscard]] bool enabled() const { return video_.is_open() || !frames_dir_.empty(); }
   /// Throws std::runtime_error if a PNG cannot be written.
   void write(const cv::Mat& frame);
   [[nodiscard]] int frames() const { return frames_; }
 
  private:
-  cv::VideoWriter video_;
+  media::VideoWriter video_;
   std::filesystem::path frames_dir_;
   int frames_ = 0;
 };
