@@ -1,8 +1,9 @@
 #include "evldt/lines/bend_test.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
-#include <optional>
 
 #include <Eigen/Dense>
 
@@ -20,10 +21,6 @@ constexpr float kOnStraight = 0.3f;    // px: an event this close to the segment
 constexpr float kMinStraight = 0.6f;   // share of an end's far bins holding such an event: it runs on straight
 constexpr float kOnCurve = 1.5f;       // px: an event this close to the fitted curve follows it
 constexpr float kMinOnCurve = 0.6f;    // share of each end's bins that must hold such an event
-
-Point2 pixel_centre(const BlockEntries& block, LatticeEntry entry) {
-  return {static_cast<float>(block.pixel_x(entry)) + 0.5f, static_cast<float>(block.pixel_y(entry)) + 0.5f};
-}
 }  // namespace
 
 BendTest::BendTest(const LatticeGeometry& geometry, float max_bend_ratio)
@@ -37,52 +34,93 @@ BendTest::BendTest(const LatticeGeometry& geometry, float max_bend_ratio)
   cells_.reserve(kLongestWalk);
   u_.reserve(most_points);
   v_.reserve(most_points);
-  bins_.resize(static_cast<std::size_t>(2 * geometry.block_size));
+  after_.reserve(most_points);
+  entry_along_.resize(static_cast<std::size_t>(geometry.capacity));
+  entry_offsets_.resize(static_cast<std::size_t>(geometry.capacity));
+  entry_keys_.resize(static_cast<std::size_t>(geometry.capacity));
 }
 
-std::optional<float> BendTest::far_offset(const ScarfLattice& lattice, const Frame& frame, Point2 end, Point2 outward) {
+bool BendTest::runs_straight(const ScarfLattice& lattice, const Frame& frame, Point2 end, Point2 outward,
+                             std::vector<float>& offsets) {
   // The far half of the extension, [b/2, b) beyond the end, in 1-px bins. Its blocks hold every
   // event of the band there (a block's region reaches b/2 beyond its square, the band 0.4 b).
   const int b = geometry_.block_size, near = b / 2, far = b - near;
   const float band = kBandRatio * static_cast<float>(b);
+  const float half_length = 0.5f * frame.length;
+  const float cx = frame.centre.x(), cy = frame.centre.y(), nx = frame.normal.x(), ny = frame.normal.y();
+  const float ox = outward.x(), oy = outward.y();
   cells_.clear();
   blocks_along({end + static_cast<float>(near) * outward, end + static_cast<float>(b) * outward}, geometry_, cells_);
-  std::fill(bins_.begin(), bins_.begin() + far, 0);
-  v_.clear();
+  // Whether an entry lies in the band there is data (about one in six does): branches on it
+  // mispredict. A first loop the compiler vectorises works out each entry's offset and its key:
+  // its bin when on the segment's line, kInBand when only in the band, kOutside. A second marks
+  // the bins (bits 0..far-1 of marks, far <= 32) and compacts the offsets without a branch.
+  constexpr std::int32_t kInBand = 32, kOutside = 33;
+  float* entry_offsets = entry_offsets_.data();
+  std::int32_t* entry_keys = entry_keys_.data();
+  std::uint64_t marks = 0;
+  std::size_t n = 0;
+  offsets.clear();
   for (const int cell : cells_) {
     const BlockEntries block = lattice.entries(cell);
-    for (const LatticeEntry entry : block.entries) {
-      const Point2 d = pixel_centre(block, entry) - frame.centre;
-      const float v = d.dot(frame.normal);
-      const float beyond = d.dot(outward) - 0.5f * frame.length;
-      if (std::abs(v) > band || beyond < static_cast<float>(near) || beyond >= static_cast<float>(b)) continue;
-      v_.push_back(v);
-      if (std::abs(v) <= kOnStraight) bins_[static_cast<std::size_t>(static_cast<int>(beyond) - near)] = 1;
+    const std::size_t count = block.entries.size();
+    const LatticeEntry* entries = block.entries.data();
+    for (std::size_t i = 0; i < count; ++i) {
+      // As Point2 arithmetic would round them: the centre's offset, then each product and sum.
+      const float dx = (static_cast<float>(block.pixel_x(entries[i])) + 0.5f) - cx;
+      const float dy = (static_cast<float>(block.pixel_y(entries[i])) + 0.5f) - cy;
+      const float v = dx * nx + dy * ny;
+      const float beyond = (dx * ox + dy * oy) - half_length;
+      const bool inside = (std::abs(v) <= band) & (beyond >= static_cast<float>(near)) & (beyond < static_cast<float>(b));
+      const std::int32_t bin = static_cast<std::int32_t>(beyond) - near;
+      entry_offsets[i] = v;
+      entry_keys[i] = !inside ? kOutside : std::abs(v) <= kOnStraight ? bin : kInBand;
+    }
+    offsets.resize(n + count);
+    for (std::size_t i = 0; i < count; ++i) {
+      offsets[n] = entry_offsets[i];
+      n += entry_keys[i] != kOutside;
+      marks |= std::uint64_t{1} << entry_keys[i];
     }
   }
-  if (static_cast<float>(std::count(bins_.begin(), bins_.begin() + far, 1)) >= kMinStraight * static_cast<float>(far)) {
-    return std::nullopt;
+  offsets.resize(n);
+  const auto on_line = static_cast<std::uint32_t>(marks);  // the bins alone
+  return static_cast<float>(std::popcount(on_line)) >= kMinStraight * static_cast<float>(far);
+}
+
+int BendTest::median_sign(const std::vector<float>& offsets) {
+  // The median is element n / 2 in sorted order: negative when more than n / 2 offsets are, positive
+  // when at most n / 2 are not. Two counts, no sort.
+  const std::size_t n = offsets.size(), middle = n / 2;
+  if (n == 0) return 0;
+  std::size_t negative = 0, positive = 0;
+  for (const float v : offsets) {
+    negative += v < 0;
+    positive += v > 0;
   }
-  if (v_.empty()) return 0.0f;
-  const auto middle = v_.begin() + static_cast<std::ptrdiff_t>(v_.size() / 2);
-  std::nth_element(v_.begin(), middle, v_.end());
+  return middle < negative ? -1 : middle >= n - positive ? 1 : 0;
+}
+
+float BendTest::median(std::vector<float>& offsets) {
+  if (offsets.empty()) return 0.0f;
+  const auto middle = offsets.begin() + static_cast<std::ptrdiff_t>(offsets.size() / 2);
+  std::nth_element(offsets.begin(), middle, offsets.end());
   return *middle;
 }
 
 bool BendTest::followed_beyond_both_ends(const Eigen::Vector3d& curve, float length, float half_span) {
-  // Bins [0, b) cover [0, b) beyond q0, bins [b, 2 b) the same beyond q1.
+  // Per end, bit i: the bin [i, i + 1) px beyond it holds an event on the curve (b <= 64 bins).
   const int b = geometry_.block_size;
-  std::fill(bins_.begin(), bins_.end(), 0);
+  std::uint64_t followed[2] = {0, 0};  // beyond q0, beyond q1
   for (std::size_t i = 0; i < u_.size(); ++i) {
     const double u = u_[i] / half_span;
     if (std::abs(v_[i] - (curve[0] + curve[1] * u + curve[2] * u * u)) > kOnCurve) continue;
     const float beyond = std::abs(u_[i]) - 0.5f * length;
     if (beyond < 0 || beyond >= static_cast<float>(b)) continue;
-    bins_[static_cast<std::size_t>(static_cast<int>(beyond) + (u_[i] > 0 ? b : 0))] = 1;
+    followed[u_[i] > 0] |= std::uint64_t{1} << static_cast<int>(beyond);
   }
-  for (int end = 0; end < 2; ++end) {
-    const auto first = bins_.begin() + end * b;
-    if (static_cast<float>(std::count(first, first + b, 1)) < kMinOnCurve * static_cast<float>(b)) return false;
+  for (const std::uint64_t bins : followed) {
+    if (static_cast<float>(std::popcount(bins)) < kMinOnCurve * static_cast<float>(b)) return false;
   }
   return true;
 }
@@ -97,31 +135,48 @@ bool BendTest::bent(const ScarfLattice& lattice, const Segment& segment) {
   const Point2 centre = 0.5f * (segment.q0 + segment.q1);
   // The common case, a straight edge, is decided from the few blocks beyond one end.
   const Frame frame{centre, normal, length};
-  const auto before = far_offset(lattice, frame, segment.q0, -unit);
-  if (!before) return false;
-  const auto after = far_offset(lattice, frame, segment.q1, unit);
-  // An arc lies off to the same side beyond both ends; a cheap look that spares most fits.
-  if (!after || *before * *after <= 0) return false;
+  if (runs_straight(lattice, frame, segment.q0, -unit, v_) || runs_straight(lattice, frame, segment.q1, unit, after_)) {
+    return false;
+  }
+  // An arc lies off to the same side beyond both ends (the median offsets); a cheap look that spares
+  // most fits. Mostly decided by the medians' signs; their product also when it can underflow.
+  if (median_sign(v_) * median_sign(after_) <= 0 || median(v_) * median(after_) <= 0) return false;
 
   const float half_span = 0.5f * length + b;
   cells_.clear();
   blocks_along({segment.q0 - b * unit, segment.q1 + b * unit}, geometry_, cells_);
   // The band's events (all entries of the blocks along it, active or not) in the segment's frame: u
   // along it from its centre, v across it.
-  u_.clear();
-  v_.clear();
+  // Two loops as in runs_straight; the compaction keeps the order, on which the fit's sums depend.
   const float band = kBandRatio * b;
+  const float cx = centre.x(), cy = centre.y(), ux = unit.x(), uy = unit.y(), nx = normal.x(), ny = normal.y();
+  float* entry_along = entry_along_.data();
+  float* entry_offsets = entry_offsets_.data();
+  std::int32_t* entry_keys = entry_keys_.data();
+  std::size_t n = 0;
   for (const int cell : cells_) {
     const BlockEntries block = lattice.entries(cell);
-    for (const LatticeEntry entry : block.entries) {
-      const Point2 d = pixel_centre(block, entry) - centre;
-      const float u = d.dot(unit), v = d.dot(normal);
-      if (std::abs(v) > band || std::abs(u) > half_span) continue;
-      u_.push_back(u);
-      v_.push_back(v);
+    const std::size_t count = block.entries.size();
+    const LatticeEntry* entries = block.entries.data();
+    for (std::size_t i = 0; i < count; ++i) {
+      const float dx = (static_cast<float>(block.pixel_x(entries[i])) + 0.5f) - cx;
+      const float dy = (static_cast<float>(block.pixel_y(entries[i])) + 0.5f) - cy;
+      const float u = dx * ux + dy * uy, v = dx * nx + dy * ny;
+      entry_along[i] = u;
+      entry_offsets[i] = v;
+      entry_keys[i] = (std::abs(v) <= band) & (std::abs(u) <= half_span);
+    }
+    u_.resize(n + count);
+    v_.resize(n + count);
+    for (std::size_t i = 0; i < count; ++i) {
+      u_[n] = entry_along[i];
+      v_[n] = entry_offsets[i];
+      n += static_cast<std::size_t>(entry_keys[i]);
     }
   }
-  if (u_.size() < 6) return false;
+  u_.resize(n);
+  v_.resize(n);
+  if (n < 6) return false;
 
   // v = a + t u + c u^2 with u scaled to [-1, 1] over the span, by robustly reweighted least squares:
   // c is how far the middle of the fitted curve lies off the chord between its ends. The weighted

@@ -17,7 +17,7 @@
 // The thresholds were tuned on circle-board, monitor-hd and tag-board (docs/whole-lines.md).
 
 #include <Eigen/Core>
-#include <optional>
+#include <cstdint>
 #include <vector>
 
 #include "evldt/lines/geometry.hpp"
@@ -38,16 +38,23 @@ class BendTest {
     Point2 centre, normal;
     float length;
   };
-  /// The median offset across the segment of the band's events in the far half of the extension
-  /// beyond `end`; nullopt when the edge runs on straight there.
-  std::optional<float> far_offset(const ScarfLattice& lattice, const Frame& frame, Point2 end, Point2 outward);
+  /// Whether the edge runs on straight in the far half of the extension beyond `end`; `offsets`
+  /// receives the offsets across the segment of the band's events there.
+  bool runs_straight(const ScarfLattice& lattice, const Frame& frame, Point2 end, Point2 outward, std::vector<float>& offsets);
+  /// The sign (-1, 0, 1) of the median of `offsets`, 0 when empty.
+  static int median_sign(const std::vector<float>& offsets);
+  /// The median of `offsets` (reordered), 0 when empty.
+  static float median(std::vector<float>& offsets);
   bool followed_beyond_both_ends(const Eigen::Vector3d& curve, float length, float half_span);
 
   LatticeGeometry geometry_;
   float min_bend_px_;
   std::vector<int> cells_;  // scratch: the blocks along the extended segment
-  std::vector<float> u_, v_;  // scratch: the band's events in the segment's frame
-  std::vector<char> bins_;    // scratch: per 1-px bin beyond each end, whether it holds an event of interest
+  std::vector<float> u_, v_;  // scratch: the band's events in the segment's frame (v_ first: the offsets beyond q0)
+  std::vector<float> after_;  // scratch: the offsets beyond q1
+  // Scratch per entry of one block: its place in the segment's frame and what it counts for.
+  std::vector<float> entry_along_, entry_offsets_;
+  std::vector<std::int32_t> entry_keys_;
 };
 
 }  // namespace evldt
