@@ -10,8 +10,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 # What the tests need beyond the product: clang and libFuzzer for the fuzz targets, iproute2 for
 # the multi-host test's network namespaces, Chromium for the web view's browser test, Node.js (npm)
-# to check exported MCAP files against Foxglove's published schemas.
-deploy/install-deps.sh clang libclang-rt-14-dev iproute2 chromium nodejs
+# to check exported MCAP files against Foxglove's published schemas, ccache for quick rebuilds.
+deploy/install-deps.sh clang libclang-rt-14-dev iproute2 chromium nodejs ccache
 source tests/suites.sh
 started=$SECONDS
 

@@ -18,8 +18,14 @@ suite_cmake_args() {  # suite_cmake_args NAME
   esac
 }
 
+# ccache (Debian's) keeps a rebuild of unchanged sources short, in this checkout or a fresh clone
+# elsewhere: paths are hashed relative to the source root, without the build folder's.
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=1
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+
 build_suite() {  # build_suite NAME: configure and build build/NAME
-  cmake -S . -B "build/$1" -G Ninja $(suite_cmake_args "$1") >/dev/null
+  cmake -S . -B "build/$1" -G Ninja $(suite_cmake_args "$1") "${launcher[@]}" >/dev/null
   cmake --build "build/$1" -j "$jobs"
 }
 

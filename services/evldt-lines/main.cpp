@@ -28,14 +28,14 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.1, 10000.0));
   app.add_option("--max-latency-ms", options.max_latency_ms,
-                 "Latency budget: event batches that queued longer than this before they could be stored are shed "
-                 "whole, unstored (counted; their time still moves the rounds on); with --overload thin, those that "
-                 "queued a quarter of it or more keep every 2nd to 4th event. 0: never shed nor thin")
+                 "Latency budget: event batches that queued longer than this before they could be stored keep every "
+                 "2nd event (every 4th past 1.5 times it) and are shed whole, unstored, past twice it (counted; their "
+                 "time still moves the rounds on); with --overload shed they are shed past it. 0: never thin nor shed")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.0, 3600000.0));
   app.add_option("--overload", options.overload,
-                 "What a batch that queued meets: thin (a share of its events kept, evenly) or shed (only whole "
-                 "batches past the latency budget, unstored)")
+                 "What a batch that queued past the latency budget meets: thin (a share of its events kept, evenly; "
+                 "shed past twice the budget) or shed (the whole batch, unstored)")
       ->transform(CLI::CheckedTransformer(std::map<std::string, OverloadPolicy>{{"thin", OverloadPolicy::Thin},
                                                                                 {"shed", OverloadPolicy::Shed}}))
       ->default_str("thin");

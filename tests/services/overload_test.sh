@@ -75,8 +75,8 @@ kill -INT "$lines_pid"
 wait "$lines_pid"
 cat "$work/idle.out"
 check "an unhurried run sheds no batch (budget $idle_budget_ms ms)" grep -qP "not stored: 0 batches" "$work/idle.out"
-# Batches that queued a quarter of the budget are thinned: a loaded machine (the suite runs tests side
-# by side) may delay a few; a wrong clock estimate would thin every batch (half of its events or more).
+# Batches that queued past the budget are thinned: a loaded machine (the suite runs tests side by
+# side) may delay a few; a wrong clock estimate would thin every batch (half of its events or more).
 idle_events=$(field "$work/idle.out" 'events +')
 idle_thinned=$(field "$work/idle.out" 'shed')
 check "... and thins at most a few ($idle_thinned of $idle_events events not stored)" \

@@ -629,12 +629,12 @@ TEST(LatencyBudget, ThinsWhatQueuedAndShedsWhatQueuedPastTheBudgetWhateverTheSen
     // Delivered in 0.3-0.5 ms; the sender's clock is `offset` behind ours.
     std::int64_t now = 10'000'000;
     for (int i = 0; i < 100; ++i, now += 1000) EXPECT_EQ(budget.stride(now - offset - 300 - (i % 3) * 100, now), 1) << offset;
-    EXPECT_EQ(budget.stride(now - offset - 300 - 4'900, now), 1);   // queued 4.9 ms: all of it kept
-    EXPECT_EQ(budget.stride(now - offset - 300 - 5'100, now), 2);   // past a quarter of the budget: every 2nd
-    EXPECT_EQ(budget.stride(now - offset - 300 - 12'000, now), 3);  // past half: every 3rd
-    EXPECT_EQ(budget.stride(now - offset - 300 - 19'000, now), 4);  // within the budget: every 4th
-    EXPECT_EQ(budget.stride(now - offset - 300 - 21'000, now), 0);  // queued 21 ms: shed whole
-    EXPECT_NEAR(static_cast<double>(budget.last_queueing_us()), 21'000, 1);
+    EXPECT_EQ(budget.stride(now - offset - 300 - 19'900, now), 1);  // queued 19.9 ms: all of it kept
+    EXPECT_EQ(budget.stride(now - offset - 300 - 20'100, now), 2);  // past the budget: every 2nd
+    EXPECT_EQ(budget.stride(now - offset - 300 - 30'100, now), 4);  // past 1.5 budgets: every 4th
+    EXPECT_EQ(budget.stride(now - offset - 300 - 39'900, now), 4);
+    EXPECT_EQ(budget.stride(now - offset - 300 - 41'000, now), 0);  // past twice: shed whole
+    EXPECT_NEAR(static_cast<double>(budget.last_queueing_us()), 41'000, 1);
   }
   LatencyBudget shed_only(20, 2'000'000, OverloadPolicy::Shed);
   std::int64_t now = 10'000'000;
@@ -658,8 +658,9 @@ TEST(LatencyBudget, WhatQueuedWhileTheConsumerStartedIsNotLate) {
   for (std::int64_t k = 1; k <= 60; ++k) EXPECT_EQ(budget.stride(now + offset - 60'000 - 400 + k * 1000, now), 1) << k;
   EXPECT_NEAR(static_cast<double>(budget.last_queueing_us()), 0, 1);  // the last of them queued briefly
   // After the start a stall is judged as ever.
-  now += 30'000;
-  EXPECT_EQ(budget.stride(now + offset - 400 - 25'000, now), 0);
+  now += 60'000;
+  EXPECT_EQ(budget.stride(now + offset - 400 - 25'000, now), 2);
+  EXPECT_EQ(budget.stride(now + offset - 400 - 45'000, now), 0);
   EXPECT_EQ(budget.stride(now + offset - 400, now), 1);
 }
 
@@ -689,8 +690,8 @@ TEST(EventBatchReceiver, ShedsLateBatchesUnreadButAccountsTheirSequence) {
   ASSERT_TRUE(receiver.receive(batch_at(0, now - 500, 0), out, budget, now));
   EXPECT_FALSE(receiver.shed());
   EXPECT_EQ(out.size(), 10u);
-  // Seq 1 queued 30 ms: shed, its events not decoded; its last event's time is kept.
-  ASSERT_TRUE(receiver.receive(batch_at(1, now - 30'500, 100), out, budget, now));
+  // Seq 1 queued 45 ms, past twice the budget: shed, its events not decoded; its last event's time is kept.
+  ASSERT_TRUE(receiver.receive(batch_at(1, now - 45'500, 100), out, budget, now));
   EXPECT_TRUE(receiver.shed());
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(receiver.shed_until_us(), 100 + 9 * 3);
@@ -698,7 +699,7 @@ TEST(EventBatchReceiver, ShedsLateBatchesUnreadButAccountsTheirSequence) {
   EXPECT_FALSE(receiver.shed());
   EXPECT_EQ(out.size(), 10u);
   // A shed batch is no loss, a late duplicate is not shed, junk is still refused.
-  EXPECT_FALSE(receiver.receive(batch_at(1, now - 30'500, 100), out, budget, now));
+  EXPECT_FALSE(receiver.receive(batch_at(1, now - 45'500, 100), out, budget, now));
   EXPECT_FALSE(receiver.receive(Bytes{1, 2, 3}, out, budget, now));
   const ReceiverCounts counts = receiver.counts();
   EXPECT_EQ(counts.sequence.received, 3u);
@@ -722,14 +723,14 @@ TEST(EventBatchReceiver, ThinsBatchesThatQueuedEvenlyKeepingTheirLastEvent) {
   ASSERT_TRUE(receiver.receive(batch_at(0, now - 500, ten), out, budget, now));
   EXPECT_FALSE(receiver.thinned());
   EXPECT_EQ(out.size(), 10u);
-  // Queued 12 ms: every 3rd event, ending with the last (events 0, 3, 6 and 9 of its ten).
+  // Queued 32 ms: every 4th event, ending with the last (events 1, 5 and 9 of its ten).
   const EventBatch later = make_events(10, 100);
-  ASSERT_TRUE(receiver.receive(batch_at(1, now - 12'500, later), out, budget, now));
+  ASSERT_TRUE(receiver.receive(batch_at(1, now - 32'500, later), out, budget, now));
   EXPECT_TRUE(receiver.thinned());
   EXPECT_FALSE(receiver.shed());
-  ASSERT_EQ(out.size(), 4u);
+  ASSERT_EQ(out.size(), 3u);
   for (std::size_t k = 0; k < out.size(); ++k) {
-    const std::size_t i = 9 - 3 * (out.size() - 1 - k);
+    const std::size_t i = 9 - 4 * (out.size() - 1 - k);
     EXPECT_EQ(out.t[k], later.t[i]) << k;
     EXPECT_EQ(out.x[k], later.x[i]) << k;
     EXPECT_EQ(out.y[k], later.y[i]) << k;
@@ -744,7 +745,7 @@ TEST(EventBatchReceiver, ThinsBatchesThatQueuedEvenlyKeepingTheirLastEvent) {
   EXPECT_EQ(counts.sequence.lost, 0u);
   EXPECT_EQ(counts.batches_shed, 0u);
   EXPECT_EQ(counts.batches_thinned, 1u);
-  EXPECT_EQ(counts.events_shed, 6u);
+  EXPECT_EQ(counts.events_shed, 7u);
 }
 
 TEST(EventBatchReceiver, RefusesSensorSizesBeyondTheLimitOrThatTheSubscriberCannotUse) {

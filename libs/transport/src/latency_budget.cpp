@@ -25,11 +25,11 @@ int LatencyBudget::stride(std::int64_t publish_utime, std::int64_t now_utime) {
   current_min_ = std::min(current_min_, delay);
   last_queueing_us_ = delay - std::min(current_min_, previous_min_);
   if (budget_us_ <= 0 || (exempt_ && publish_utime <= exempt_until_publish_)) return 1;
-  if (last_queueing_us_ > budget_us_) return 0;
-  // 1 up to a quarter of the budget, then one more for each further quarter: 2, 3, 4.
-  if (policy_ == OverloadPolicy::Shed || last_queueing_us_ <= 0) return 1;
-  const std::int64_t step = std::max<std::int64_t>(budget_us_ / kThinningSteps, 1);
-  return static_cast<int>(std::min<std::int64_t>((last_queueing_us_ + step - 1) / step, kThinningSteps));
+  if (last_queueing_us_ <= budget_us_) return 1;
+  if (policy_ == OverloadPolicy::Shed || last_queueing_us_ > 2 * budget_us_) return 0;
+  // Thinned from the budget on, not below it: thinning earlier (from a quarter or half of it) stretched
+  // the rounds and thinned batches storage would have caught up with (docs/realtime.md, issue 48).
+  return last_queueing_us_ <= budget_us_ * 3 / 2 ? 2 : 4;
 }
 
 void LatencyBudget::ready_at(std::int64_t now_utime) {

@@ -37,8 +37,8 @@ struct LinesNodeOptions {
   std::function<PipelineConfig(SensorSize)> configure = default_config_for;
   Timestamp time_slack_us = 1000;
   double publish_hz = 100;  ///< at most this many segment lists a second: one after each round, when rounds are faster
-  /// Batches that queued longer than this before they could be stored are shed whole (0: never);
-  /// below it, those that queued are thinned (LatencyBudget).
+  /// Batches that queued longer than this before they could be stored are thinned, past twice it
+  /// shed whole (LatencyBudget; 0: never).
   double max_latency_ms = kDefaultMaxLatencyMs;
   OverloadPolicy overload = OverloadPolicy::Thin;
   double stats_hz = 1;

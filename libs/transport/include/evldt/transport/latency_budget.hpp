@@ -1,8 +1,8 @@
 #pragma once
-// The latency budget of a live subscriber (DESIGN 9, bounded latency): a batch that queued is
-// thinned (every k-th event kept, k growing with the queueing), so that the events kept still span
-// all of its time and the whole sensor, and storage catches up at once; one that queued past the
-// budget is shed whole (the last resort: a stretch of time without events). The lattice keeps only
+// The latency budget of a live subscriber (DESIGN 9, bounded latency): a batch that queued longer
+// than the budget is thinned (every 2nd event kept, every 4th past 1.5 budgets), so that the events
+// kept still span all of its time and the whole sensor, and storage catches up; one that queued
+// twice the budget is shed whole (the last resort: a stretch of time without events). The lattice keeps only
 // each block's newest events, so answers from a little less data beat answers a second old.
 //
 // Lateness is judged against the quickest delivery seen lately, not against the sender's clock
@@ -15,24 +15,22 @@
 
 namespace evldt {
 
-/// What a subscriber does with a batch that queued: keep every event but a share (thin), or only
-/// shed whole batches past the budget (the policy before thinning, for comparison).
+/// What a subscriber does with a batch that queued past the budget: keep a share of its events
+/// (thin, and shed only past twice the budget), or shed it whole (the policy before thinning).
 enum class OverloadPolicy : std::uint8_t { Thin, Shed };
 
 class LatencyBudget {
  public:
-  /// Batches that queued longer than a quarter of the budget keep every 2nd event, half of it every
-  /// 3rd, three quarters every 4th (OverloadPolicy::Thin).
-  static constexpr int kThinningSteps = 4;
-
-  /// `max_latency_ms`: the queueing a batch may have met before it is shed; 0 never sheds nor thins.
+  /// `max_latency_ms`: the queueing a batch may have met before it is thinned (OverloadPolicy::Thin)
+  /// or shed (OverloadPolicy::Shed); 0 never does either.
   /// `window_us`: how long the quickest delivery is remembered (the estimate spans one to two windows).
   explicit LatencyBudget(double max_latency_ms, std::int64_t window_us = 2'000'000,
                          OverloadPolicy policy = OverloadPolicy::Thin);
 
   /// A batch published at `publish_utime` (sender's clock) arrives at `now_utime` (ours): how much of
-  /// it to store, as every stride-th event: 1 all of it, 0 none (it queued longer than the budget:
-  /// shed it whole). Every arrival refines the estimate.
+  /// it to store, as every stride-th event: 1 all of it (it queued at most the budget); with
+  /// OverloadPolicy::Thin 2 past the budget, 4 past 1.5 budgets and 0 (none: shed it whole) past
+  /// twice; with OverloadPolicy::Shed 0 past the budget. Every arrival refines the estimate.
   int stride(std::int64_t publish_utime, std::int64_t now_utime);
 
   /// The consumer was not ready until `now_utime` (ours): its store was being built. Batches
