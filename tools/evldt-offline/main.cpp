@@ -17,6 +17,7 @@
 #include "evldt/lines/whole_lines.hpp"
 #include "evldt/render/frame_writer.hpp"
 #include "evldt/render/line_picture.hpp"
+#include "evldt/sources/read_ahead.hpp"
 
 namespace {
 
@@ -103,25 +104,34 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   summary.input = source.name();
   const auto started = Clock::now();
   auto last_progress = started;
-  EventBatch batch;
   std::optional<Timestamp> first_t;
-  try {
-    while (source.read(batch)) {
-      summary.events_read += batch.size();
+  Timestamp newest_t = 0;
+  {
+    // Reading, decoding, validating and filtering on a thread of their own, a few batches ahead of
+    // storage and the rounds (the same output: the pipeline sees the same batches in the same order).
+    ReadAhead reader(source, [&](EventBatch& batch, EventBatch& filtered) {
       validator.filter(batch);
-      if (!batch.empty() && !first_t) first_t = batch.t.front();
-      pipeline.process(batch);
-      if (!options.quiet && Clock::now() - last_progress > std::chrono::seconds(2)) {
-        last_progress = Clock::now();
-        spdlog::info("progress: {:.0f}%, {} events, {:.2f} s of event time, {} live lines",
-                     100.0 * source.progress(),
-                     summary.events_read, static_cast<double>(validator.newest_time() - first_t.value_or(0)) * 1e-6,
-                     pipeline.lines().lines().size());
+      pipeline.filter(batch, filtered);
+    });
+    try {
+      while (const ReadAhead::Item* item = reader.next()) {
+        summary.events_read += item->events_read;
+        if (!item->batch.empty()) {
+          if (!first_t) first_t = item->batch.t.front();
+          newest_t = item->batch.t.back();
+        }
+        pipeline.process_filtered(item->batch, item->prepared);
+        if (!options.quiet && Clock::now() - last_progress > std::chrono::seconds(2)) {
+          last_progress = Clock::now();
+          spdlog::info("progress: {:.0f}%, {} events, {:.2f} s of event time, {} live lines", 100.0 * item->progress,
+                       summary.events_read, static_cast<double>(newest_t - first_t.value_or(0)) * 1e-6,
+                       pipeline.lines().lines().size());
+        }
       }
+    } catch (const FormatError& error) {
+      spdlog::error("{} (every event before it was processed)", error.what());
+      summary.input_error = error.what();
     }
-  } catch (const FormatError& error) {
-    spdlog::error("{} (every event before it was processed)", error.what());
-    summary.input_error = error.what();
   }
   csv.close();
   if (whole_csv) {

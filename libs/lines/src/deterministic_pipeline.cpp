@@ -51,6 +51,24 @@ void DeterministicPipeline::update_next_due() {
 
 void DeterministicPipeline::process(const EventBatch& batch) {
   if (batch.empty()) return;
+  if (filters_.empty()) {
+    process_filtered(batch, batch);
+  } else {
+    filters_.filter(batch, filtered_);
+    process_filtered(batch, filtered_);
+  }
+}
+
+void DeterministicPipeline::filter(const EventBatch& batch, EventBatch& filtered) {
+  if (filters_.empty()) {
+    filtered = batch;
+  } else {
+    filters_.filter(batch, filtered);
+  }
+}
+
+void DeterministicPipeline::process_filtered(const EventBatch& batch, const EventBatch& filtered) {
+  if (batch.empty()) return;
   // The schedule follows the input's clock: events the filters drop still move event time on.
   if (!started_) {
     start(batch.t[0]);
@@ -58,12 +76,7 @@ void DeterministicPipeline::process(const EventBatch& batch) {
     ++counters_.clock_restarts;
     start(batch.t[0]);
   }
-  if (filters_.empty()) {
-    store(batch);
-  } else {
-    filters_.filter(batch, filtered_);
-    store(filtered_);
-  }
+  store(filtered);
   // Rounds due up to the batch's last event: every stored event is older than them (store() ran
   // each round due at or before a stored event's time before storing it).
   if (batch.t.back() >= next_due_) run_rounds_until(batch.t.back());

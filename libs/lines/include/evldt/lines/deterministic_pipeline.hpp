@@ -39,6 +39,12 @@ class DeterministicPipeline {
   /// clock reset upstream, the schedule begins again at the first batch more than kClockStepBackUs
   /// behind it.
   void process(const EventBatch& batch);
+  /// process() in two stages, the first of which may run on another thread, a few batches ahead:
+  /// filter() runs the noise filters alone (the only state it touches), process_filtered() stores
+  /// what passed and runs the rounds, with `batch` as given to filter() (its times move the schedule
+  /// on). Called in the same order, they give process()'s output.
+  void filter(const EventBatch& batch, EventBatch& filtered);
+  void process_filtered(const EventBatch& batch, const EventBatch& filtered);
 
   [[nodiscard]] const LineMap& lines() const { return lines_; }
   [[nodiscard]] LineMap& lines() { return lines_; }
