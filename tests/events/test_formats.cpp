@@ -436,7 +436,7 @@ TEST(EcdText, MalformedLinesAreReportedAtTheirStartWithTheirNumber) {
   for (const std::string bad : {"0.2 abc 3 0", "0.2 1 2", "0.2 1 2 2", "0.2 -1 2 1", "0.2 1 65536 1", "0.2 1 2 1 junk",
                                 "-0.2 1 2 1", "0.2e3 1 2 1", "0.2. 1 2 1", ". 1 2 1", "0,2 1 2 1", "0.2 1 2 10",
                                 "0.2 1 2 1x", "0.2 1 2 +1", "0.2 1 2 1 0", "0.2 1 0065536 1", "0. 1 2 1",
-                                "1234567890123 1 2 1"}) {
+                                "1234567890123 1 2 1", "88888888888888888888888888.5 1 2 1"}) {
     SCOPED_TRACE(bad);
     EventBatch batch;
     const auto decoder = make_decoder(EventFormat::EcdText, "events.txt");

@@ -1,5 +1,6 @@
 // Event Camera Dataset events.txt: one "t x y p" line per event, t in seconds as decimal text.
 
+#include <algorithm>
 #include <charconv>
 #include <cstring>
 #include <string_view>
@@ -55,9 +56,10 @@ bool is_digit(char c) { return c >= '0' && c <= '9'; }
 /// read, for any other line, which the general path then reads or reports.
 bool parse_plain_line(const char* s, const char* end, Timestamp& t, std::uint16_t& x, std::uint16_t& y, std::int8_t& p) {
   const char* const whole_begin = s;
+  const char* const whole_limit = s + std::min<std::ptrdiff_t>(end - s, static_cast<std::ptrdiff_t>(kMaxSecondsDigits));
   Timestamp us = 0;
-  while (s < end && is_digit(*s)) us = us * 10 + (*s++ - '0');
-  if (s == whole_begin || static_cast<std::size_t>(s - whole_begin) > kMaxSecondsDigits) return false;
+  while (s < whole_limit && is_digit(*s)) us = us * 10 + (*s++ - '0');
+  if (s == whole_begin || (s < end && is_digit(*s))) return false;  // none, or more than the general path takes
   std::size_t fraction_digits = 0;
   bool round_up = false;
   if (s < end && *s == '.') {

@@ -164,7 +164,7 @@ bool BendTest::bent(const ScarfLattice& lattice, const Segment& segment) {
       const float u = dx * ux + dy * uy, v = dx * nx + dy * ny;
       entry_along[i] = u;
       entry_offsets[i] = v;
-      entry_keys[i] = (std::abs(v) <= band) & (std::abs(u) <= half_span);
+      entry_keys[i] = static_cast<std::int32_t>(std::abs(v) <= band) & static_cast<std::int32_t>(std::abs(u) <= half_span);
     }
     u_.resize(n + count);
     v_.resize(n + count);
