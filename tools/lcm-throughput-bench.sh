@@ -131,7 +131,7 @@ for speed in $speeds; do
   lost=$(field "$work/lines.out" 'received,')
   events_shed=$(field "$work/lines.out" 'shed')
   batches_shed=$(field "$work/lines.out" 'not stored:')
-  batches_thinned=$(field "$work/lines.out" 'latency budget,')
+  batches_thinned=$(field "$work/lines.out" 'shed whole,')
   events_in=$(field "$work/lines.out" 'events')
   batches_shed=${batches_shed:-0}
   batches_thinned=${batches_thinned:-0}

@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
     std::printf(
         "evldt-lines summary\n"
         "  batches   %llu received, %llu lost (sequence gaps), %llu late (%llu resyncs), %llu invalid messages, %llu camera restarts\n"
-        "  shed      %llu events, not stored: %llu batches later than the %.0f ms latency budget, %llu thinned\n"
+        "  shed      %llu events, not stored: %llu batches shed whole, %llu thinned (latency budget %.0f ms)\n"
         "  events    %llu received, %llu stored, %llu dropped as invalid (%llu off sensor, %llu back in time), %llu clock resets\n"
         "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
         "  loops     %llu detection rounds (%llu while shedding, without the bend test), %llu tracking rounds\n"
@@ -90,8 +90,8 @@ int main(int argc, char** argv) {
         static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.sequence.resyncs),
         static_cast<unsigned long long>(t.receiver.invalid_messages),
         static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.receiver.events_shed),
-        static_cast<unsigned long long>(t.receiver.batches_shed), options.max_latency_ms,
-        static_cast<unsigned long long>(t.receiver.batches_thinned),
+        static_cast<unsigned long long>(t.receiver.batches_shed), static_cast<unsigned long long>(t.receiver.batches_thinned),
+        options.max_latency_ms,
         static_cast<unsigned long long>(t.events_received),
         static_cast<unsigned long long>(t.events_stored),
         static_cast<unsigned long long>(t.receiver.drops.total()), static_cast<unsigned long long>(t.receiver.drops.off_sensor),

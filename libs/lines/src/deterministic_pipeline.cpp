@@ -52,9 +52,9 @@ void DeterministicPipeline::update_next_due() {
 void DeterministicPipeline::process(const EventBatch& batch) {
   if (batch.empty()) return;
   if (filters_.empty()) {
-    process_filtered(batch, batch);
+    process_filtered(batch, batch);  // no copy through filter()
   } else {
-    filters_.filter(batch, filtered_);
+    filter(batch, filtered_);
     process_filtered(batch, filtered_);
   }
 }
