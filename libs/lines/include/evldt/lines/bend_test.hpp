@@ -41,6 +41,8 @@ class BendTest {
   /// Whether the edge runs on straight in the far half of the extension beyond `end`; `offsets`
   /// receives the offsets across the segment of the band's events there.
   bool runs_straight(const ScarfLattice& lattice, const Frame& frame, Point2 end, Point2 outward, std::vector<float>& offsets);
+  /// Along one axis, the block (0 .. blocks - 1) whose region's centre is nearest `coordinate`.
+  [[nodiscard]] int nearest_region(float coordinate, int blocks) const;
   /// The sign (-1, 0, 1) of the median of `offsets`, 0 when empty.
   static int median_sign(const std::vector<float>& offsets);
   /// The median of `offsets` (reordered), 0 when empty.
