@@ -154,6 +154,20 @@ fi
 [[ $(grep '^frames_seg.csv' "$work/by_frames.txt" | head -1) == $(grep '^frames_seg.csv' "$work/by_csv.txt") ]] ||
   fail "--write-gt CSV and --frames-gt score differently: $(cat "$work/by_frames.txt" "$work/by_csv.txt")"
 grep -Eq '^frames_seg.csv +1 s 0\.[0-9]{3} / 0\.[0-9]{3}$' "$work/by_frames.txt" || fail "--per-second: $(cat "$work/by_frames.txt")"
+# The same recording on a clock of Unix-epoch microseconds, as DV writes them (issue 49): the same
+# scores and the same per-second table, nothing allocated by the clock's value.
+mkdir -p "$work/epoch"
+shift_seconds() { awk -v OFS=' ' '{ split($1, t, "."); $1 = sprintf("%d.%s", t[1] + 1600000000, t[2]); print }' "$1"; }
+shift_seconds "$work/frames/events.txt" >"$work/epoch/events.txt"
+shift_seconds "$work/frames/images.txt" >"$work/epoch/images.txt"
+ln -s "$work/frames/images" "$work/epoch/images"
+"$offline" "$work/epoch/events.txt" --width 640 --height 480 -q --output-period-us 10000 -o "$work/epoch_seg.csv" >/dev/null
+"$eval" --segments "$work/epoch_seg.csv" --frames-gt "$work/epoch" --width 640 --height 480 --per-second \
+  >"$work/by_epoch_frames.txt" 2>"$work/by_epoch_frames.err" || fail "--frames-gt on an epoch clock: $(cat "$work/by_epoch_frames.err")"
+same_run() { awk '{ if ($1 == "frames_seg.csv" || $1 == "epoch_seg.csv") $1 = "run"; $1 = $1; print }' "$1"; }
+diff <(same_run "$work/by_frames.txt") <(same_run "$work/by_epoch_frames.txt") >&2 ||
+  fail "an epoch clock scores differently from a clock from 0 (above)"
+echo "ok: --frames-gt and --per-second on Unix-epoch time stamps score as on a clock from 0"
 sed -i '5s/frame_00000004/frame_missing/' "$work/frames/images.txt"
 set +e
 "$eval" --scene three-lines-fast --duration-s 0.2 --frames-gt "$work/frames" >"$work/frames_bad.txt" 2>&1

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <sstream>
@@ -353,6 +354,43 @@ TEST(StreamEvaluator, CumulativePerSecondSumsTheStepsUpToEachSecond) {
   EXPECT_DOUBLE_EQ(seconds[2].recall, 2.0 / 5.0);
   EXPECT_DOUBLE_EQ(seconds[2].precision, 1.0);
   EXPECT_DOUBLE_EQ(seconds[2].recall, evaluator.accuracy().summed_prf(0).recall);
+}
+
+// A clock anywhere in the 64-bit range (DV writes Unix-epoch microseconds): the same table as the
+// clock from 0, and nothing allocated by the clock's value.
+TEST(StreamEvaluator, CumulativePerSecondIsTheSameOnAClockShiftedToTheEpochOrTheEndOfTheRange) {
+  auto seconds_from = [](Timestamp origin) {
+    GroundTruthSteps truth;
+    for (const Timestamp t : {0, 500'000, 1'500'000, 2'000'000, 2'500'000}) truth.times.push_back(origin + t);
+    truth.segments_at = [](std::size_t, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+      segments.assign(1, moving_line(0));
+      ids.assign(1, 3);
+    };
+    StreamEvaluator evaluator(kSensor, {0.01}, truth, 100'000);
+    predict(evaluator, origin, 1, {moving_line(0)});
+    predict(evaluator, origin + 500'000, 1, {moving_line(0)});
+    evaluator.finish();
+    std::vector<double> recalls;
+    for (const Prf& p : evaluator.cumulative_per_second()) recalls.push_back(p.recall);
+    return recalls;
+  };
+  const std::vector<double> from_zero = seconds_from(0);
+  ASSERT_EQ(from_zero.size(), 3u);
+  EXPECT_EQ(seconds_from(1'600'000'000'000'000), from_zero);  // 2020 in Unix-epoch microseconds
+  EXPECT_EQ(seconds_from(-7'000'000'000'000'000), from_zero);
+  EXPECT_EQ(seconds_from(std::numeric_limits<Timestamp>::max() / 1'000'000 * 1'000'000 - 3'000'000), from_zero);
+}
+
+TEST(StreamEvaluator, StepsSpanningMoreSecondsThanTheTableHoldsAreAClearError) {
+  GroundTruthSteps truth;
+  truth.times = {0, static_cast<Timestamp>(StreamEvaluator::kMaxSeconds + 1) * 1'000'000};
+  truth.segments_at = [](std::size_t, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments.assign(1, moving_line(0));
+    ids.assign(1, 3);
+  };
+  StreamEvaluator evaluator(kSensor, {0.01}, truth, 100'000);
+  predict(evaluator, 0, 1, {moving_line(0)});
+  EXPECT_THROW(evaluator.finish(), std::length_error);
 }
 
 TEST(StreamEvaluator, APredictionThatLagsOnePeriodIsScoredAgainstTheTruthOfItsStep) {

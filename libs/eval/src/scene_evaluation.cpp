@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "evldt/events/event_validator.hpp"
 #include "evldt/lines/whole_lines.hpp"
@@ -89,11 +90,29 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
     for (std::size_t i = 0; i < matchers_.size(); ++i) counts_[i] = matchers_[i].match(predicted, truth_);
     accuracy_.add_step(counts_, predicted.size(), truth_.size());
     const Timestamp t = times[next_step_];
-    const auto second = static_cast<std::size_t>(t > 0 ? (t - 1) / 1'000'000 : 0);
-    if (per_second_.size() <= second) per_second_.resize(second + 1);
-    per_second_[second] += counts_[0];
+    add_to_second(t, counts_[0]);
     tracking_.add_step(t, predicted_ids, predicted, truth_ids_, truth_);
   }
+}
+
+void StreamEvaluator::add_to_second(Timestamp t, const MatchCounts& counts) {
+  // The seconds count from the whole second of the clock that holds the first step, so a clock that
+  // starts at the Unix epoch's microseconds bins as one that starts at 0 (and nothing is allocated by
+  // the clock's value).
+  constexpr Timestamp kSecond = 1'000'000;
+  if (!seconds_origin_) {
+    const Timestamp into_second = ((t % kSecond) + kSecond) % kSecond;
+    seconds_origin_ = t >= std::numeric_limits<Timestamp>::min() + into_second ? t - into_second : t;
+  }
+  // Steps come in time order, so t is at or after the origin: the difference is exact unsigned.
+  const std::uint64_t since = static_cast<std::uint64_t>(t) - static_cast<std::uint64_t>(*seconds_origin_);
+  const std::uint64_t second = since > 0 ? (since - 1) / kSecond : 0;
+  if (second >= kMaxSeconds) {
+    throw std::length_error("ground-truth steps span more than " + std::to_string(kMaxSeconds) +
+                            " seconds: the per-second table would not fit (a step at " + std::to_string(t) + " us)");
+  }
+  if (per_second_.size() <= second) per_second_.resize(static_cast<std::size_t>(second) + 1);
+  per_second_[static_cast<std::size_t>(second)] += counts;
 }
 
 std::vector<Prf> StreamEvaluator::cumulative_per_second() const {

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -71,21 +72,26 @@ class StreamEvaluator {
   [[nodiscard]] const TrackingEvaluator& tracking() const { return tracking_; }
   [[nodiscard]] const StepCoverage& coverage() const { return coverage_; }
   /// The paper's view, at the first tolerance: element k - 1 is the P/R/F of the counts summed over
-  /// the ground-truth steps up to k seconds (a step at t_us belongs to second ceil(t / 1 s), t = 0
-  /// to the first), for each second up to the last step's.
+  /// the ground-truth steps up to k seconds, for each second up to the last step's. Seconds count
+  /// from the whole second of the clock that holds the first step, t0: a step at t belongs to second
+  /// ceil((t - t0) / 1 s), t0 itself to the first. Throws std::length_error past kMaxSeconds.
   [[nodiscard]] std::vector<Prf> cumulative_per_second() const;
+  static constexpr std::uint64_t kMaxSeconds = 1'000'000;  ///< of the per-second table: 11.6 days
   [[nodiscard]] Timestamp hold_us() const { return hold_us_; }
   [[nodiscard]] const GroundTruthSteps& ground_truth() const { return ground_truth_; }
 
  private:
   /// Scores every ground-truth step before `until` against the held prediction.
   void score_steps_before(Timestamp until);
+  /// Adds a step's counts at the first tolerance to its second.
+  void add_to_second(Timestamp t, const MatchCounts& counts);
 
   std::vector<HeatmapMatcher> matchers_;
   EvaluationAccumulator accuracy_;
   LifetimeTracker lifetimes_;
   TrackingEvaluator tracking_;
   std::vector<MatchCounts> per_second_;  // first tolerance, by second of the step time
+  std::optional<Timestamp> seconds_origin_;  // t0 of cumulative_per_second(), set by the first step
   GroundTruthSteps ground_truth_;
   Timestamp hold_us_;
   std::size_t next_step_ = 0;
