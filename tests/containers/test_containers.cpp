@@ -558,13 +558,19 @@ std::vector<std::uint8_t> compress(aedat4::CompressionType compression, const st
   }
 }
 
-std::vector<std::uint8_t> dv_event_packet(const EventBatch& events, std::size_t from, std::size_t to) {
+/// A DV event packet; without `identifier`, as writers other than DV may leave out its EVTS.
+std::vector<std::uint8_t> dv_event_packet(const EventBatch& events, std::size_t from, std::size_t to, bool identifier = true) {
   flatbuffers::FlatBufferBuilder builder;
   std::vector<dv::Event> elements;
   for (std::size_t i = from; i < to; ++i) {
     elements.emplace_back(events.t[i], static_cast<std::int16_t>(events.x[i]), static_cast<std::int16_t>(events.y[i]), events.p[i] > 0);
   }
-  dv::FinishSizePrefixedEventPacketBuffer(builder, dv::CreateEventPacket(builder, builder.CreateVectorOfStructs(elements)));
+  const auto packet = dv::CreateEventPacket(builder, builder.CreateVectorOfStructs(elements));
+  if (identifier) {
+    dv::FinishSizePrefixedEventPacketBuffer(builder, packet);
+  } else {
+    builder.FinishSizePrefixed(packet);
+  }
   return {builder.GetBufferPointer(), builder.GetBufferPointer() + builder.GetSize()};
 }
 
@@ -585,14 +591,30 @@ const char* kInfoXml = R"(<dv version="2.0">
     </node>
 </dv>)";
 
+/// How a writer lays out the IOHeader.
+enum class HeaderLayout {
+  Dv,     ///< as DV writes it: size-prefixed, with the identifier "IOHE", fields in the schema's order
+  Other,  ///< as other writers may: every field written, in another order, and no identifiers
+};
+
 /// An AEDAT 4.0 file: the events in packets of `per_packet` on stream 4, an IMU packet (stream 1)
 /// between them. Returns where each packet header starts.
 std::vector<std::uint64_t> write_aedat4(const std::filesystem::path& path, const EventBatch& events, std::size_t per_packet,
-                                        aedat4::CompressionType compression) {
+                                        aedat4::CompressionType compression, HeaderLayout layout = HeaderLayout::Dv) {
   std::vector<std::uint8_t> file(kAedat4Magic.begin(), kAedat4Magic.end());
-  // Size-prefixed with the identifier, as DV writes it.
   flatbuffers::FlatBufferBuilder prefixed;
-  aedat4::FinishSizePrefixedIOHeaderBuffer(prefixed, aedat4::CreateIOHeaderDirect(prefixed, compression, -1, kInfoXml));
+  if (layout == HeaderLayout::Dv) {
+    aedat4::FinishSizePrefixedIOHeaderBuffer(prefixed, aedat4::CreateIOHeaderDirect(prefixed, compression, -1, kInfoXml));
+  } else {
+    // The fields added in reverse: the table lists the string first and the compression last.
+    prefixed.ForceDefaults(true);
+    const auto info = prefixed.CreateString(kInfoXml);
+    aedat4::IOHeaderBuilder header(prefixed);
+    header.add_infoNode(info);
+    header.add_dataTablePosition(-1);
+    header.add_compression(compression);
+    prefixed.FinishSizePrefixed(header.Finish());
+  }
   file.insert(file.end(), prefixed.GetBufferPointer(), prefixed.GetBufferPointer() + prefixed.GetSize());
   std::vector<std::uint64_t> packet_starts;
   auto packet = [&](std::int32_t stream, const std::vector<std::uint8_t>& payload) {
@@ -603,7 +625,7 @@ std::vector<std::uint64_t> write_aedat4(const std::filesystem::path& path, const
     file.insert(file.end(), compressed.begin(), compressed.end());
   };
   for (std::size_t at = 0; at < events.size(); at += per_packet) {
-    packet(4, dv_event_packet(events, at, std::min(events.size(), at + per_packet)));
+    packet(4, dv_event_packet(events, at, std::min(events.size(), at + per_packet), layout == HeaderLayout::Dv));
     packet(1, std::vector<std::uint8_t>(40, 7));  // not events: skipped
   }
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
@@ -625,6 +647,22 @@ TEST(Aedat4, PolarityPacketsInEveryCompressionWithSensorAndCameraFromTheHeader) 
     EXPECT_EQ(result.events, events_of(events));
     EXPECT_EQ(result.sensor, (SensorSize{346, 260}));
     EXPECT_NE(result.name.find("camera DAVIS346_00000499"), std::string::npos) << result.name;
+  }
+}
+
+// A header of another writer (issue 49: a clip rewritten by a third-party library was refused):
+// any field order, no file identifier; it reads as DV's.
+TEST(Aedat4, AHeaderInAnotherFieldOrderWithoutTheIdentifierReadsInEveryCompression) {
+  TempDir dir;
+  const EventBatch events = sweep_events(1000, 100);
+  for (const auto compression : {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
+    SCOPED_TRACE(static_cast<int>(compression));
+    const auto path = dir.file("other.aedat4");
+    write_aedat4(path, events, 300, compression, HeaderLayout::Other);
+    const ReadAll result = read_all(path);
+    EXPECT_EQ(result.error, "");
+    EXPECT_EQ(result.events, events_of(events));
+    EXPECT_EQ(result.sensor, (SensorSize{346, 260}));
   }
 }
 

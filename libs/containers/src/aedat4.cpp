@@ -97,8 +97,10 @@ class Aedat4Container {
     if (header_size > detail::kMaxDecompressedBytes) throw FormatError(path_, file_.position() - 4, "header size " + std::to_string(header_size));
     header.resize(4 + header_size);
     file_.read_exactly(header.data() + 4, header_size, "the header");
+    // The identifier "IOHE" is DV's; other writers leave it out, so it is not required. The verifier
+    // checks the rest (every offset, the table's fields in whatever order its vtable lists them).
     flatbuffers::Verifier verifier(header.data(), header.size());
-    if (!aedat4::VerifySizePrefixedIOHeaderBuffer(verifier)) {
+    if (!verifier.VerifySizePrefixedBuffer<aedat4::IOHeader>(nullptr)) {
       throw FormatError(path_, header_at_, "the header is not a valid IOHeader FlatBuffer");
     }
     const aedat4::IOHeader* io = aedat4::GetSizePrefixedIOHeader(header.data());
@@ -236,7 +238,9 @@ class Aedat4Images final : public ImageSource {
     if (!container_.next_packet(stream_id_, payload_, at)) return false;
     location = container_.path() + ": frame packet at byte " + std::to_string(at);
     flatbuffers::Verifier verifier(payload_.data(), payload_.size());
-    if (!dv::VerifySizePrefixedFrameBuffer(verifier)) throw std::runtime_error(location + ": not a valid Frame FlatBuffer");
+    if (!verifier.VerifySizePrefixedBuffer<dv::Frame>(nullptr)) {  // the identifier FRME is DV's alone
+      throw std::runtime_error(location + ": not a valid Frame FlatBuffer");
+    }
     const dv::Frame* frame = dv::GetSizePrefixedFrame(payload_.data());
     int channels = 1;
     switch (frame->format()) {

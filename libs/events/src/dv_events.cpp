@@ -26,9 +26,10 @@ class DvEventsDecoder final : public EventDecoder {
       std::memcpy(aligned_.data(), packet.data(), packet.size());
       packet = {reinterpret_cast<const std::uint8_t*>(aligned_.data()), packet.size()};
     }
+    // The identifier EVTS is DV's; other writers leave it out, so it is not required.
     flatbuffers::Verifier verifier(packet.data(), packet.size());
-    if (!dv::VerifySizePrefixedEventPacketBuffer(verifier)) {
-      throw FormatError(source_, 0, "not a valid size-prefixed FlatBuffer event packet (identifier EVTS)");
+    if (!verifier.VerifySizePrefixedBuffer<dv::EventPacket>(nullptr)) {
+      throw FormatError(source_, 0, "not a valid size-prefixed FlatBuffer event packet");
     }
     const dv::EventPacket* events = dv::GetSizePrefixedEventPacket(packet.data());
     if (events->elements() == nullptr) return;
