@@ -162,12 +162,14 @@ shift_seconds "$work/frames/events.txt" >"$work/epoch/events.txt"
 shift_seconds "$work/frames/images.txt" >"$work/epoch/images.txt"
 ln -s "$work/frames/images" "$work/epoch/images"
 "$offline" "$work/epoch/events.txt" --width 640 --height 480 -q --output-period-us 10000 -o "$work/epoch_seg.csv" >/dev/null
-"$eval" --segments "$work/epoch_seg.csv" --frames-gt "$work/epoch" --width 640 --height 480 --per-second \
+# (No --width/--height: the frames say the sensor's size.)
+"$eval" --segments "$work/epoch_seg.csv" --frames-gt "$work/epoch" --per-second \
   >"$work/by_epoch_frames.txt" 2>"$work/by_epoch_frames.err" || fail "--frames-gt on an epoch clock: $(cat "$work/by_epoch_frames.err")"
 same_run() { awk '{ if ($1 == "frames_seg.csv" || $1 == "epoch_seg.csv") $1 = "run"; $1 = $1; print }' "$1"; }
 diff <(same_run "$work/by_frames.txt") <(same_run "$work/by_epoch_frames.txt") >&2 ||
   fail "an epoch clock scores differently from a clock from 0 (above)"
-echo "ok: --frames-gt and --per-second on Unix-epoch time stamps score as on a clock from 0"
+grep -q "sensor 640x480: the size of the frames" "$work/by_epoch_frames.err" || fail "the sensor size not taken from the frames: $(cat "$work/by_epoch_frames.err")"
+echo "ok: --frames-gt and --per-second on Unix-epoch time stamps score as on a clock from 0, the sensor size from the frames"
 sed -i '5s/frame_00000004/frame_missing/' "$work/frames/images.txt"
 set +e
 "$eval" --scene three-lines-fast --duration-s 0.2 --frames-gt "$work/frames" >"$work/frames_bad.txt" 2>&1

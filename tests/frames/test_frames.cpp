@@ -91,6 +91,27 @@ TEST_F(FramesTest, WrittenFramesReadBackInOrder) {
   EXPECT_FALSE(reader->next());
 }
 
+// Where a recording says its size only by its frames (evldt-eval --frames-gt without --width/--height).
+TEST_F(FramesTest, AnUnsetSensorTakesTheFirstFramesSizeAndRefusesAnotherLater) {
+  EcdFrameWriter writer(folder_);
+  writer.write(0, square(8));
+  writer.write(10'000, square(12));
+  writer.close();
+  EXPECT_EQ(frames_sensor_size(folder_, ""), kSensor);
+  cv::imwrite((folder_ / "images" / "small.png").string(), cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)));
+  write_list("0.0 images/frame_00000000.png\n0.01 images/small.png\n");
+  const auto reader = open_frames(folder_, "", SensorSize{0, 0});
+  ASSERT_TRUE(reader->next());
+  try {
+    reader->next();
+    ADD_FAILURE() << "a second frame of another size must be refused";
+  } catch (const FrameError& e) {
+    EXPECT_NE(std::string(e.what()).find("small.png is 10x10, the sensor 64x48"), std::string::npos) << e.what();
+  }
+  write_list("");
+  EXPECT_THROW(frames_sensor_size(folder_, ""), FrameError);
+}
+
 TEST_F(FramesTest, BadInputsNameTheFrame) {
   EcdFrameWriter writer(folder_);
   writer.write(0, square(8));

@@ -331,9 +331,13 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       spdlog::error("with --segments give the ground truth: --ground-truth FILE, --scene NAME or --frames-gt SOURCE");
       return 1;
     }
-    const auto sensor = sim.scene_selected() ? std::optional<SensorSize>(sim.scene().sensor) : pipeline_options.sensor();
+    std::optional<SensorSize> sensor = sim.scene_selected() ? std::optional<SensorSize>(sim.scene().sensor) : pipeline_options.sensor();
+    if (!sensor && !options.frames_gt.empty()) {
+      sensor = frames_sensor_size(options.frames_gt, options.frames_topic);
+      spdlog::info("sensor {}x{}: the size of the frames of {}", sensor->width, sensor->height, options.frames_gt.string());
+    }
     if (!sensor) {
-      spdlog::error("give the sensor size (--width/--height or --config) for file-only evaluation");
+      spdlog::error("give the sensor size (--width/--height or --config) for file-only evaluation without --frames-gt");
       return 1;
     }
     std::vector<SegmentRow> rows = read_segments(options);

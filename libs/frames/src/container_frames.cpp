@@ -12,6 +12,8 @@
 namespace evldt {
 namespace {
 
+constexpr std::uint32_t kMaxSide = 1u << 16;  // px: larger than any sensor; beyond it the size is garbage
+
 /// The image as 8-bit grey, or FrameError naming the frame. 16-bit pixels keep their high byte (a
 /// DAVIS's 10-bit APS read as mono16 spans the whole 16-bit range).
 cv::Mat grey_of(const RecordingImage& image, const std::string& name) {
@@ -67,7 +69,8 @@ class ImageFrameReader final : public FrameReader {
       throw FrameError(location + ": frame at " + std::to_string(frame.t_us) + " us is earlier than the one before (" +
                        std::to_string(last_us_) + " us)");
     }
-    if (image.width != static_cast<std::uint32_t>(sensor_.width) || image.height != static_cast<std::uint32_t>(sensor_.height)) {
+    if (image.width > kMaxSide || image.height > kMaxSide ||
+        !fits_sensor(sensor_, static_cast<int>(image.width), static_cast<int>(image.height))) {
       throw FrameError(location + ": frame is " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", the sensor " +
                        std::to_string(sensor_.width) + "x" + std::to_string(sensor_.height));
     }
@@ -85,6 +88,19 @@ class ImageFrameReader final : public FrameReader {
 };
 
 }  // namespace
+
+bool fits_sensor(SensorSize& sensor, int width, int height) {
+  if (sensor.width == 0 && sensor.height == 0) sensor = {width, height};
+  return sensor.width == width && sensor.height == height;
+}
+
+SensorSize frames_sensor_size(const std::filesystem::path& path, const std::string& stream) {
+  SensorSize size{0, 0};
+  const auto frames = open_frames(path, stream, size);
+  const auto first = frames->next();
+  if (!first) throw FrameError(path.string() + ": no frame to take the sensor size from");
+  return {first->image.cols, first->image.rows};
+}
 
 std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream, SensorSize sensor) {
   if (std::filesystem::is_directory(path) || path.filename() == "images.txt") return open_ecd_frames(path, sensor);

@@ -40,7 +40,7 @@ class EcdFrameReader final : public FrameReader {
       if (!std::filesystem::is_regular_file(frame.name)) throw FrameError(where() + ": frame " + frame.name + " is missing");
       frame.image = media::read_image(frame.name, cv::IMREAD_GRAYSCALE);
       if (frame.image.empty()) throw FrameError(where() + ": frame " + frame.name + " is not an image");
-      if (frame.image.cols != sensor_.width || frame.image.rows != sensor_.height) {
+      if (!fits_sensor(sensor_, frame.image.cols, frame.image.rows)) {
         throw FrameError(where() + ": frame " + frame.name + " is " + std::to_string(frame.image.cols) + "x" +
                          std::to_string(frame.image.rows) + ", the sensor " + std::to_string(sensor_.width) + "x" +
                          std::to_string(sensor_.height));

@@ -24,7 +24,7 @@ class VideoFrameReader final : public FrameReader {
     Frame frame;
     frame.name = path_ + ", frame " + std::to_string(index_);
     frame.t_us = video_frame_time_us(index_++, fps_);
-    if (image_.cols != sensor_.width || image_.rows != sensor_.height) {
+    if (!fits_sensor(sensor_, image_.cols, image_.rows)) {
       throw FrameError(frame.name + " is " + std::to_string(image_.cols) + "x" + std::to_string(image_.rows) + ", the sensor " +
                        std::to_string(sensor_.width) + "x" + std::to_string(sensor_.height));
     }

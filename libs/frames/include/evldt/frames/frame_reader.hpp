@@ -49,14 +49,22 @@ std::unique_ptr<FrameReader> open_ecd_frames(const std::filesystem::path& path, 
 /// here and of the events emulated from the video (libs/sources).
 Timestamp video_frame_time_us(std::uint64_t index, double fps);
 
+/// Whether a frame of width x height belongs to `sensor`; an unset sensor ({0, 0}) takes the size of
+/// the first frame asked about, which every later one must then have.
+bool fits_sensor(SensorSize& sensor, int width, int height);
+
+/// The size of the first frame of `path` (as open_frames reads it): the sensor's, where a recording
+/// says it only by its frames. Throws FrameError as open_frames does, or when there is no frame.
+SensorSize frames_sensor_size(const std::filesystem::path& path, const std::string& stream);
+
 /// The frames of `path`, whichever container it is: an ECD folder (or its images.txt); a ROS 1 or
 /// ROS 2 bag's (.db3 or MCAP) sensor_msgs/Image topic `stream` (empty: the first; pixel encodings
 /// mono8, mono16 (its high byte), bgr8 and rgb8, as grey); MVSEC's HDF5 frames `stream` (empty:
 /// /davis/left/image_raw, with its _ts times); the frames of an AEDAT 4.0 recording's first frame
 /// stream, of AEDAT 3.1 frame packets, of jAER's AEDAT 2.0 DAVIS APS samples (reset - signal), each at
 /// the middle of its exposure (libs/containers: aedat4.hpp, aedat_images.hpp); else a video file OpenCV opens (as grey, at its
-/// frame rate, else 30 fps, as --from-video emulates events from it). Throws FrameError naming the
-/// path for anything else or a container without them.
+/// frame rate, else 30 fps, as --from-video emulates events from it). `sensor` {0, 0}: the first
+/// frame's size. Throws FrameError naming the path for anything else or a container without them.
 std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream, SensorSize sensor);
 
 }  // namespace evldt
