@@ -356,6 +356,23 @@ TEST(StreamEvaluator, CumulativePerSecondSumsTheStepsUpToEachSecond) {
   EXPECT_DOUBLE_EQ(seconds[2].recall, evaluator.accuracy().summed_prf(0).recall);
 }
 
+// The steps of an lcm-log's recorded span (evldt-eval --segments LOG): each kept step keeps its own
+// segments (the times alone were once cut, and the later steps were scored against the first ones').
+TEST(GroundTruthSteps, StepsWithinASpanKeepTheirOwnSegments) {
+  std::vector<GroundTruthRow> rows;
+  for (int k = 0; k < 5; ++k) rows.push_back({k * 10'000, GtSegment{k, Vec2d(k, 0), Vec2d(k, 20)}});
+  const GroundTruthSteps within = steps_within(csv_ground_truth_steps(rows), 15'000, 40'000);
+  ASSERT_EQ(within.times, (std::vector<Timestamp>{20'000, 30'000, 40'000}));
+  std::vector<Segment> segments;
+  std::vector<std::uint64_t> ids;
+  for (std::size_t i = 0; i < within.times.size(); ++i) {
+    within.segments_at(i, segments, ids);
+    ASSERT_EQ(ids.size(), 1u);
+    EXPECT_EQ(ids[0], i + 2);
+    EXPECT_FLOAT_EQ(segments[0].q0.x(), static_cast<float>(i + 2));
+  }
+}
+
 // A clock anywhere in the 64-bit range (DV writes Unix-epoch microseconds): the same table as the
 // clock from 0, and nothing allocated by the clock's value.
 TEST(StreamEvaluator, CumulativePerSecondIsTheSameOnAClockShiftedToTheEpochOrTheEndOfTheRange) {

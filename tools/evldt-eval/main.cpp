@@ -138,7 +138,7 @@ StreamEvaluator evaluate_files(const Options& options, std::vector<SegmentRow> r
   if (from_log) {
     if (const auto span = recorded_event_span(options.segments, options.lcm_channel)) {
       const std::size_t before = truth.times.size();
-      std::erase_if(truth.times, [&](Timestamp t) { return t < span->first || t > span->second; });
+      truth = steps_within(std::move(truth), span->first, span->second);
       spdlog::info("scoring the {} of {} ground-truth steps within the recorded events ({:.3f} .. {:.3f} s)",
                    truth.times.size(), before, static_cast<double>(span->first) * 1e-6,
                    static_cast<double>(span->second) * 1e-6);

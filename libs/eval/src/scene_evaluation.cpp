@@ -51,6 +51,21 @@ GroundTruthSteps csv_ground_truth_steps(const std::vector<GroundTruthRow>& rows)
   return steps;
 }
 
+GroundTruthSteps steps_within(GroundTruthSteps truth, Timestamp first, Timestamp last) {
+  GroundTruthSteps within;
+  std::vector<std::size_t> kept;  // the index in `truth` of each step kept
+  for (std::size_t i = 0; i < truth.times.size(); ++i) {
+    if (truth.times[i] < first || truth.times[i] > last) continue;
+    within.times.push_back(truth.times[i]);
+    kept.push_back(i);
+  }
+  within.segments_at = [kept = std::move(kept), segments_at = std::move(truth.segments_at)](
+                           std::size_t index, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments_at(kept.at(index), segments, ids);
+  };
+  return within;
+}
+
 Timestamp median_step_spacing(std::span<const Timestamp> sorted_times) {
   std::vector<Timestamp> gaps;
   for (std::size_t i = 1; i < sorted_times.size(); ++i) {

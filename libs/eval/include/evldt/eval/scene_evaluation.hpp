@@ -34,6 +34,9 @@ GroundTruthSteps scene_ground_truth_steps(const Scene& scene, Timestamp step_us)
 /// The steps of a ground-truth CSV: each distinct time of its rows. (A step with no visible edge
 /// has no row, so it cannot be a step here.)
 GroundTruthSteps csv_ground_truth_steps(const std::vector<GroundTruthRow>& rows);
+/// The steps of `truth` at times in [first, last], each with its own segments (segments_at's
+/// indices are the kept steps').
+GroundTruthSteps steps_within(GroundTruthSteps truth, Timestamp first, Timestamp last);
 
 /// How a prediction stream lined up with the ground-truth steps.
 struct StepCoverage {
