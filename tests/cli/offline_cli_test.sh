@@ -170,6 +170,19 @@ diff <(same_run "$work/by_frames.txt") <(same_run "$work/by_epoch_frames.txt") >
   fail "an epoch clock scores differently from a clock from 0 (above)"
 grep -q "sensor 640x480: the size of the frames" "$work/by_epoch_frames.err" || fail "the sensor size not taken from the frames: $(cat "$work/by_epoch_frames.err")"
 echo "ok: --frames-gt and --per-second on Unix-epoch time stamps score as on a clock from 0, the sensor size from the frames"
+# --overlay: a picture per scored frame, the predictions drawn over it (the same frames with no
+# prediction give other pictures).
+"$eval" --segments "$work/frames_seg.csv" --frames-gt "$work/frames" --overlay "$work/overlay" >/dev/null 2>&1 ||
+  fail "--overlay failed"
+[[ $(ls "$work/overlay" | grep -c '^step_[0-9]*\.png$') -eq 21 ]] || fail "--overlay: 21 pictures for 21 frames: $(ls "$work/overlay")"
+[[ $(head -c 8 "$work/overlay/step_00010.png" | od -An -tx1 | tr -d ' ') == 89504e470d0a1a0a ]] || fail "--overlay wrote no PNG"
+head -1 "$work/frames_seg.csv" >"$work/no_seg.csv"
+"$eval" --segments "$work/no_seg.csv" --frames-gt "$work/frames" --overlay "$work/overlay_none" >/dev/null 2>&1
+cmp -s "$work/overlay/step_00010.png" "$work/overlay_none/step_00010.png" && fail "--overlay drew no prediction"
+if "$eval" --segments "$work/frames_seg.csv" --scene three-lines-fast --overlay "$work/overlay_bad" >/dev/null 2>&1; then
+  fail "--overlay without --frames-gt must be refused"
+fi
+echo "ok: --overlay writes a picture per scored frame with the predictions drawn"
 sed -i '5s/frame_00000004/frame_missing/' "$work/frames/images.txt"
 set +e
 "$eval" --scene three-lines-fast --duration-s 0.2 --frames-gt "$work/frames" >"$work/frames_bad.txt" 2>&1

@@ -14,6 +14,7 @@
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/simulator_options.hpp"
 #include "evldt/eval/frame_ground_truth.hpp"
+#include "evldt/eval/overlay.hpp"
 #include "evldt/json/json_writer.hpp"
 #include "evldt/eval/plots.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
@@ -28,7 +29,7 @@ namespace {
 using namespace evldt;
 
 struct Options {
-  std::filesystem::path segments, whole_lines, ground_truth, frames_gt, write_gt, json, pr_png, lifetime_png, tracks_png;
+  std::filesystem::path segments, whole_lines, ground_truth, frames_gt, write_gt, json, pr_png, lifetime_png, tracks_png, overlay;
   LsdParams lsd;
   std::string lcm_channel;
   std::string label;  ///< of the --segments row
@@ -195,6 +196,20 @@ std::map<Timestamp, std::vector<Segment>> steps_of(const std::vector<SegmentRow>
   return steps;
 }
 
+// --overlay: the frames with LSD's lines and the lines held at each, as scored.
+void write_overlay_pictures(const Options& options, const StreamEvaluator& scored, const std::vector<SegmentRow>& segments,
+                            const std::vector<SegmentRow>& whole_lines, SensorSize sensor) {
+  std::vector<Timestamp> whole_line_times;
+  for (const SegmentRow& row : whole_lines) whole_line_times.push_back(row.t_us);
+  std::sort(whole_line_times.begin(), whole_line_times.end());
+  whole_line_times.erase(std::unique(whole_line_times.begin(), whole_line_times.end()), whole_line_times.end());
+  const Timestamp whole_line_hold = StreamEvaluator::hold_for_period(median_step_spacing(whole_line_times));
+  const auto frames = open_frames(options.frames_gt, options.frames_topic, sensor);
+  const std::size_t pictures = write_overlays(options.overlay, *frames, scored.ground_truth(), {segments, scored.hold_us()},
+                                              {whole_lines, whole_line_hold});
+  spdlog::info("wrote {} pictures of the scored frames to {}", pictures, options.overlay.string());
+}
+
 // The predicted segments of --segments: a CSV, or the segment lists of an lcm-log.
 std::vector<SegmentRow> read_segments(const Options& options) {
   return is_lcm_log(options.segments) ? read_segment_log(options.segments, options.lcm_channel)
@@ -203,8 +218,8 @@ std::vector<SegmentRow> read_segments(const Options& options) {
 
 // The support of a whole-line file by the segments of the same run (evldt-offline -o and
 // --whole-lines): every step of the whole lines against the segments of the same time.
-SupportSummary file_support(const std::vector<SegmentRow>& segment_rows, const std::filesystem::path& whole_lines) {
-  const auto whole = steps_of(read_segment_csv(whole_lines));
+SupportSummary file_support(const std::vector<SegmentRow>& segment_rows, const std::vector<SegmentRow>& whole_line_rows) {
+  const auto whole = steps_of(whole_line_rows);
   const auto segments = steps_of(segment_rows);
   WholeLineSupport support;
   std::uint64_t unmatched = 0;
@@ -313,7 +328,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   }
   if (!options.whole_lines.empty() && options.ground_truth.empty() && options.frames_gt.empty() && !sim.scene_selected()) {
     // No ground truth: the support alone (a real recording).
-    const SupportSummary support = file_support(read_segments(options), options.whole_lines);
+    const SupportSummary support = file_support(read_segments(options), read_segment_csv(options.whole_lines));
     print_support(options.whole_lines.filename().string(), support);
     if (!options.json.empty()) {
       std::ofstream out(options.json);
@@ -325,6 +340,10 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       if (!json.done() || !out) throw std::runtime_error("error writing " + options.json.string());
     }
     return 0;
+  }
+  if (!options.overlay.empty() && (options.segments.empty() || options.frames_gt.empty())) {
+    spdlog::error("--overlay draws the frames of --frames-gt with the lines of --segments: give both");
+    return 1;
   }
   if (!options.segments.empty()) {
     if (options.frames_gt.empty() && options.ground_truth.empty() == !sim.scene_selected()) {
@@ -342,8 +361,14 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     }
     std::vector<SegmentRow> rows = read_segments(options);
     std::optional<SupportSummary> support;
-    if (!options.whole_lines.empty()) support = file_support(rows, options.whole_lines);
+    std::vector<SegmentRow> whole_line_rows;
+    if (!options.whole_lines.empty()) {
+      whole_line_rows = read_segment_csv(options.whole_lines);
+      support = file_support(rows, whole_line_rows);
+    }
+    const std::vector<SegmentRow> overlay_rows = options.overlay.empty() ? std::vector<SegmentRow>() : rows;
     last.emplace(evaluate_files(options, std::move(rows), *sensor, sim));
+    if (!options.overlay.empty()) write_overlay_pictures(options, *last, overlay_rows, whole_line_rows, *sensor);
     reports.push_back(make_report(*last));
     reports.back().label = options.label.empty() ? options.segments.filename().string() : options.label;
     reports.back().support = support;
@@ -467,6 +492,9 @@ int main(int argc, char** argv) {
   app.add_option("--pr-thresholds", options.pr_thresholds, "Scene runs: f_th values for a PR curve")
       ->check(finite_number() & CLI::Range(0.0, 1.0));
   app.add_option("--json", options.json, "Write the results as JSON");
+  app.add_option("--overlay", options.overlay,
+                 "With --segments and --frames-gt: a folder of one PNG per scored frame, the frame with LSD's lines\n"
+                 "(green), the segments held at its time (red) and the --whole-lines (blue)");
   app.add_option("--pr-png", options.pr_png, "Plot precision/recall over the thresholds (first tolerance)");
   app.add_option("--lifetime-png", options.lifetime_png,
                  "Histogram of segment lifetimes (with --pr-thresholds one file per run, NAME-f<threshold>.png)");
