@@ -200,4 +200,25 @@ set -e
 grep -q "junk.bin: not a source of frames evldt reads" "$work/frames_junk.txt" || fail "junk frames: $(cat "$work/frames_junk.txt")"
 grep -Eq "WARN|ERROR:" "$work/frames_junk.txt" && fail "OpenCV's own messages leaked: $(cat "$work/frames_junk.txt")"
 echo "ok: frames written at 100 Hz, LSD on them F@1% $lsd_f against the exact lines; a missing frame is named, a file of no frames refused"
-echo "offline CLI: 11 passed, 0 failed"
+
+# The paper's evaluation on a real DAVIS346 recording (AEDAT 4.0 from DV, Unix-epoch time stamps, APS
+# frames): segments and whole lines scored against LSD on its frames, per second, with pictures.
+real=$src/../shared/real/davis346_aestream_example.aedat4
+if [[ -f $real ]]; then
+  "$offline" "$real" -q -o "$work/real_seg.csv" --whole-lines "$work/real_whole.csv" >/dev/null 2>"$work/real_offline.err" ||
+    fail "evldt-offline on $real: $(cat "$work/real_offline.err")"
+  for run in seg whole; do
+    "$eval" --segments "$work/real_$run.csv" --frames-gt "$real" --per-second --overlay "$work/real_overlay_$run" \
+      >"$work/real_$run.txt" 2>"$work/real_$run.err" || fail "evldt-eval on $real: $(cat "$work/real_$run.err")"
+    grep -q "sensor 346x260: the size of the frames" "$work/real_$run.err" || fail "sensor size of $real: $(cat "$work/real_$run.err")"
+    grep -q "3 ground-truth steps scored" "$work/real_$run.err" || fail "3 frames of $real scored: $(cat "$work/real_$run.err")"
+    awk -v run="real_$run.csv" '$1 == run && $2 == "-" { found = 1; if (!($5 > 0.1)) exit 1 } END { exit !found }' "$work/real_$run.txt" ||
+      fail "F@1% of the $run on $real: $(cat "$work/real_$run.txt")"
+    grep -Eq "^real_$run.csv +1 s .* 2 s 0\.[0-9]{3} / 0\.[0-9]{3}$" "$work/real_$run.txt" || fail "per second on $real: $(cat "$work/real_$run.txt")"
+    [[ $(ls "$work/real_overlay_$run" | grep -c '\.png$') -eq 3 ]] || fail "3 pictures of $real"
+  done
+  echo "ok: $real scored against LSD on its 3 frames, segments and whole lines, per second, with pictures"
+else
+  echo "skip: no real recordings at $src/../shared/real (../shared is absent)"
+fi
+echo "offline CLI: every check passed"
