@@ -81,6 +81,24 @@ head -c 20000 "$work/run.lcmlog" >"$work/cut.lcmlog"
 "$export_tool" "$work/cut.lcmlog" "$work/cut.mcap" >"$work/cut.out" 2>"$work/cut.err"
 status=$?
 check "a log cut short exports what it holds, or says why not (exit $status, no crash)" test "$status" -lt 128
+# A log damaged in the middle (64 zeroed bytes over a record's header: LCM's own reader skipped them
+# without a word) is read past the damage, and all three tools that read logs say what they skipped.
+# (Zeroed bytes inside a message's data cannot be told from data: LCM messages carry no checksum.)
+cp "$work/run.lcmlog" "$work/damaged.lcmlog"
+size=$(stat -c %s "$work/damaged.lcmlog")
+middle=$(LC_ALL=C grep -obUaP '\xED\xA1\xDA\x01' "$work/damaged.lcmlog" | awk -F: -v half=$((size / 2)) '$1 >= half { print $1; exit }')
+dd if=/dev/zero of="$work/damaged.lcmlog" bs=1 seek="${middle:-0}" count=64 conv=notrunc status=none
+"$export_tool" "$work/damaged.lcmlog" "$work/damaged.mcap" >"$work/damaged.out" 2>"$work/damaged.err"
+check "evldt-export reads a damaged log to its end (exit $?)" grep -qP "written   [1-9][0-9]* pictures" "$work/damaged.out"
+check "... and counts the damage in its summary" grep -qP "damage    [1-9][0-9]* bytes in 1 place" "$work/damaged.out"
+check "... and says it" grep -q "damaged.lcmlog: [0-9]* damaged bytes skipped in 1 place(s), the first at byte" "$work/damaged.err"
+"$offline" "$work/damaged.lcmlog" -q -o "$work/damaged.csv" >/dev/null 2>"$work/damaged_offline.err"
+check "evldt-offline on a damaged log says what it skipped" grep -q "damaged bytes skipped" "$work/damaged_offline.err"
+"$eval_tool" --segments "$work/damaged.lcmlog" --scene boxes-6dof --duration-s 1 >/dev/null 2>"$work/damaged_eval.err"
+check "evldt-eval on a damaged log says what it skipped" grep -q "damaged bytes skipped" "$work/damaged_eval.err"
+head -c $((size - 7)) "$work/run.lcmlog" >"$work/cut_end.lcmlog"
+"$export_tool" "$work/cut_end.lcmlog" "$work/cut_end.mcap" >"$work/cut_end.out" 2>"$work/cut_end.err"
+check "a log whose last record is cut short says so" grep -q "cut_end.lcmlog: the last record (at byte [0-9]*) is cut short" "$work/cut_end.err"
 "$export_tool" "$work/run.lcmlog" "$work/other.mcap" --camera front >/dev/null 2>"$work/other.err"
 check "a camera not in the log is refused" grep -q "no valid event batch on EVENTS_FRONT" "$work/other.err"
 "$export_tool" "$work/run.lcmlog" "$work/no/such/folder/x.mcap" >/dev/null 2>"$work/folder.err"

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <random>
 #include <thread>
+#include <unistd.h>
 
 #include "evldt/transport/channels.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
@@ -17,6 +19,7 @@
 #include "evldt/transport/event_batcher.hpp"
 #include "evldt/transport/latency_tracker.hpp"
 #include "evldt/transport/lcm_log.hpp"
+#include "evldt/transport/lcm_log_reader.hpp"
 #include "evldt/transport/messages.hpp"
 #include "evldt/transport/pacer.hpp"
 #include "evldt/transport/payload_queue.hpp"
@@ -977,3 +980,142 @@ TEST(PayloadQueue, AFullQueueHoldsTheProducerUntilASlotFreesOrItStops) {
   EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 2u);
   EXPECT_THROW(evldt::PayloadQueue(0, 8), std::invalid_argument);
 }
+
+namespace evldt {
+namespace {
+
+// ---- lcm-logs read with every damage said (issue 51) ----------------------------------------------
+
+/// A log of `count` records written by LCM's own LogFile, record k on channel "CH_k%3" with k + 40
+/// bytes of k; returns where each record starts.
+std::vector<std::uint64_t> write_lcm_log(const std::filesystem::path& path, int count) {
+  std::vector<std::uint64_t> starts;
+  lcm::LogFile log(path.string(), "w");
+  for (int k = 0; k < count; ++k) {
+    starts.push_back(static_cast<std::uint64_t>(std::ftell(log.getFilePtr())));
+    std::vector<std::uint8_t> data(static_cast<std::size_t>(k + 40), static_cast<std::uint8_t>(k));
+    lcm::LogEvent event{};
+    event.eventnum = k;
+    event.timestamp = 1'600'000'000'000'000 + k * 1000;
+    event.channel = "CH_" + std::to_string(k % 3);
+    event.datalen = static_cast<std::int32_t>(data.size());
+    event.data = data.data();
+    log.writeEvent(&event);
+  }
+  return starts;
+}
+
+struct ReadLog {
+  std::vector<std::int64_t> numbers;
+  LogDamage damage;
+};
+
+ReadLog read_log(const std::filesystem::path& path) {
+  LcmLogReader reader(path);
+  LcmLogReader::Record record;
+  ReadLog result;
+  while (reader.next(record)) {
+    EXPECT_EQ(record.channel, "CH_" + std::to_string(record.number % 3));
+    EXPECT_EQ(record.data, std::vector<std::uint8_t>(static_cast<std::size_t>(record.number + 40), static_cast<std::uint8_t>(record.number)));
+    EXPECT_EQ(record.t_us, 1'600'000'000'000'000 + record.number * 1000);
+    result.numbers.push_back(record.number);
+  }
+  result.damage = reader.damage();
+  return result;
+}
+
+void overwrite(const std::filesystem::path& path, std::uint64_t at, const std::string& bytes) {
+  std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);
+  file.seekp(static_cast<std::streamoff>(at));
+  file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::vector<std::int64_t> numbers_but(int count, std::initializer_list<std::int64_t> lost) {
+  std::vector<std::int64_t> numbers;
+  for (std::int64_t k = 0; k < count; ++k) {
+    if (std::find(lost.begin(), lost.end(), k) == lost.end()) numbers.push_back(k);
+  }
+  return numbers;
+}
+
+class LcmLogReaderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = std::filesystem::temp_directory_path() / ("evldt_log_" + std::to_string(::getpid()) + ".lcm");
+    starts_ = write_lcm_log(path_, kRecords);
+  }
+  void TearDown() override { std::filesystem::remove(path_); }
+  static constexpr int kRecords = 12;
+  std::filesystem::path path_;
+  std::vector<std::uint64_t> starts_;
+};
+
+TEST_F(LcmLogReaderTest, AWholeLogReadsEveryRecordAndNoDamage) {
+  const ReadLog log = read_log(path_);
+  EXPECT_EQ(log.numbers, numbers_but(kRecords, {}));
+  EXPECT_FALSE(log.damage.any());
+}
+
+// 64 zeroed bytes over record 5's header: LCM's reader skipped them without a word.
+TEST_F(LcmLogReaderTest, ZeroedBytesInTheMiddleAreSkippedCountedAndTheRestRead) {
+  overwrite(path_, starts_[5] + 10, std::string(64, '\0'));
+  const ReadLog log = read_log(path_);
+  EXPECT_EQ(log.numbers, numbers_but(kRecords, {5}));
+  EXPECT_EQ(log.damage.regions, 1u);
+  EXPECT_EQ(log.damage.first_at, starts_[5]);
+  EXPECT_EQ(log.damage.skipped_bytes, starts_[6] - starts_[5]);
+  EXPECT_FALSE(log.damage.cut);
+}
+
+TEST_F(LcmLogReaderTest, ACutLastRecordIsSaidAndEveryWholeOneRead) {
+  for (const std::uint64_t cut_after : {std::uint64_t{3}, std::uint64_t{20}, std::uint64_t{40}}) {
+    SCOPED_TRACE(cut_after);
+    write_lcm_log(path_, kRecords);
+    std::filesystem::resize_file(path_, starts_[kRecords - 1] + cut_after);
+    const ReadLog log = read_log(path_);
+    EXPECT_EQ(log.numbers, numbers_but(kRecords - 1, {}));
+    EXPECT_TRUE(log.damage.cut);
+    EXPECT_EQ(log.damage.cut_at, starts_[kRecords - 1]);
+    EXPECT_EQ(log.damage.regions, 0u);
+  }
+}
+
+TEST_F(LcmLogReaderTest, ALengthDamagedToSwallowTheNextRecordsLosesOnlyItsOwn) {
+  // Record 3's data length (the header's last four bytes) made 200 bytes longer: records 4 and on
+  // start inside it, so its lengths are damaged.
+  std::ifstream in(path_, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(starts_[3] + 24));
+  unsigned char length[4];
+  in.read(reinterpret_cast<char*>(length), 4);
+  in.close();
+  length[3] = static_cast<unsigned char>(length[3] + 200);
+  overwrite(path_, starts_[3] + 24, std::string(reinterpret_cast<char*>(length), 4));
+  const ReadLog log = read_log(path_);
+  EXPECT_EQ(log.numbers, numbers_but(kRecords, {3}));
+  EXPECT_EQ(log.damage.regions, 1u);
+  EXPECT_EQ(log.damage.first_at, starts_[3]);
+}
+
+TEST_F(LcmLogReaderTest, GarbageBeforeTheFirstRecordAndAtTheEndIsCounted) {
+  std::string bytes;
+  {
+    std::ifstream in(path_, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  std::ofstream(path_, std::ios::binary) << std::string(17, 'x') << bytes << std::string(2, 'y');
+  const ReadLog log = read_log(path_);
+  EXPECT_EQ(log.numbers, numbers_but(kRecords, {}));
+  EXPECT_EQ(log.damage.regions, 2u);
+  EXPECT_EQ(log.damage.skipped_bytes, 19u);
+  EXPECT_EQ(log.damage.first_at, 0u);
+}
+
+TEST_F(LcmLogReaderTest, AnEmptyOrMissingFile) {
+  std::ofstream(path_, std::ios::trunc).close();
+  EXPECT_TRUE(read_log(path_).numbers.empty());
+  EXPECT_FALSE(read_log(path_).damage.any());
+  EXPECT_THROW(LcmLogReader(path_.string() + ".missing"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace evldt

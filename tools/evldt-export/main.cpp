@@ -30,10 +30,13 @@ int main(int argc, char** argv) {
     std::printf("evldt-export summary\n"
                 "  camera    %s\n"
                 "  written   %llu pictures, %llu segment lists, %llu whole-line lists, %llu statistics -> %s\n"
-                "  skipped   %llu undecodable, %llu of other channels or cameras\n",
+                "  skipped   %llu undecodable, %llu of other channels or cameras\n"
+                "  damage    %llu bytes in %llu place(s)%s\n",
                 counts.camera.c_str(), static_cast<unsigned long long>(counts.images), static_cast<unsigned long long>(counts.segment_lists),
                 static_cast<unsigned long long>(counts.whole_line_lists), static_cast<unsigned long long>(counts.stats), mcap.string().c_str(),
-                static_cast<unsigned long long>(counts.invalid), static_cast<unsigned long long>(counts.other_messages));
+                static_cast<unsigned long long>(counts.invalid), static_cast<unsigned long long>(counts.other_messages),
+                static_cast<unsigned long long>(counts.damage.skipped_bytes), static_cast<unsigned long long>(counts.damage.regions),
+                counts.damage.cut ? ", the last record cut short" : "");
     return 0;
   });
 }

@@ -1,7 +1,6 @@
 #include "evldt/export/log_export.hpp"
 
 #include <cctype>
-#include <lcm/lcm-cpp.hpp>
 #include <opencv2/imgcodecs.hpp>  // its constants; the calls go through evldt::media
 #include <optional>
 #include <stdexcept>
@@ -26,9 +25,10 @@ bool same_camera(const std::string& a, const std::string& b) {
 
 /// The camera of the first EVENTS_* channel, or empty.
 std::string first_camera(const std::filesystem::path& path) {
-  const auto log = open_lcm_log(path);
-  while (const lcm::LogEvent* event = log->readNextEvent()) {
-    if (event->channel.starts_with("EVENTS_")) return event->channel.substr(7);
+  LcmLogReader log(path);
+  LcmLogReader::Record record;
+  while (log.next(record)) {
+    if (record.channel.starts_with("EVENTS_")) return record.channel.substr(7);
   }
   return {};
 }
@@ -40,7 +40,8 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
   if (!(options.image_hz > 0 && options.image_hz <= 1000)) throw std::invalid_argument("picture rate must be in (0, 1000] Hz");
   if (options.scale < 1 || options.scale > 8) throw std::invalid_argument("scale must be in 1..8");
   if (options.jpeg_quality < 1 || options.jpeg_quality > 100) throw std::invalid_argument("JPEG quality must be in 1..100");
-  const auto log = open_lcm_log(log_path);
+  LcmLogReader log(log_path);
+  LcmLogReader::Record record;
   LogExportCounts counts;
   counts.camera = options.camera.empty() ? first_camera(log_path) : options.camera;
   if (counts.camera.empty()) throw std::runtime_error("no event batches (EVENTS_* channel) in LCM log " + log_path.string());
@@ -72,10 +73,11 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
   const AnnotationStyle segment_style{.thickness = 1, .by_status = true};
   const AnnotationStyle whole_line_style{.thickness = 2, .by_status = false, .ids = true};
   bool any_batch = false;
-  while (const lcm::LogEvent* event = log->readNextEvent()) {
-    const auto time_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(event->timestamp, 0)) * 1000u;
+  while (log.next(record)) {
+    const LcmLogReader::Record* event = &record;
+    const auto time_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(event->t_us, 0)) * 1000u;
     if (event->channel == events) {
-      if (!receiver.receive(log_payload(*event), batch)) {
+      if (!receiver.receive(event->data, batch)) {
         ++counts.invalid;
         continue;
       }
@@ -85,16 +87,16 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
         lattice.emplace(params.sensor, params.block_size, params.alpha, /*keep_surface=*/true);
       }
       for (std::size_t i = 0; i < batch.size(); ++i) lattice->insert(batch.x[i], batch.y[i]);
-      if (event->timestamp < next_image_us) continue;
+      if (event->t_us < next_image_us) continue;
       // A picture a period after the last; after a pause in the recording, a period after this one.
       next_image_us += period_us;
-      if (next_image_us <= event->timestamp) next_image_us = event->timestamp + period_us;
+      if (next_image_us <= event->t_us) next_image_us = event->t_us + period_us;
       render_scene(*receiver.sensor(), lattice->surface(), {}, render, canvas);
       media::encode_image(".jpg", canvas, jpeg, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
       mcap.write(image_channel, time_ns, compressed_image_json(time_ns, counts.camera, jpeg));
       ++counts.images;
     } else if (event->channel == lines || event->channel == whole_lines) {
-      if (decode_message(log_payload(*event), list) != WireError::None || !read_segment_list(list, tracked)) {
+      if (decode_message(event->data, list) != WireError::None || !read_segment_list(list, tracked)) {
         ++counts.invalid;
         continue;
       }
@@ -103,7 +105,7 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
                  image_annotations_json(time_ns, tracked, whole ? whole_line_style : segment_style, options.scale));
       ++(whole ? counts.whole_line_lists : counts.segment_lists);
     } else if (event->channel == kStatsChannel) {
-      if (decode_message(log_payload(*event), stats) != WireError::None) {
+      if (decode_message(event->data, stats) != WireError::None) {
         ++counts.invalid;
         continue;
       }
@@ -117,7 +119,8 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
       ++counts.other_messages;
     }
   }
-  report_unread_tail(*log, log_path);
+  log.report();
+  counts.damage = log.damage();
   if (!any_batch) throw std::runtime_error("no valid event batch on " + events + " in LCM log " + log_path.string());
   mcap.close();
   return counts;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <fstream>
-#include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
 
@@ -17,26 +16,6 @@ bool channel_matches(const std::string& wanted, std::string_view prefix, const s
 
 }  // namespace
 
-std::unique_ptr<lcm::LogFile> open_lcm_log(const std::filesystem::path& path) {
-  auto log = std::make_unique<lcm::LogFile>(path.string(), "r");
-  if (!log->good()) throw std::runtime_error("cannot open LCM log " + path.string());
-  return log;
-}
-
-std::span<const std::uint8_t> log_payload(const lcm::LogEvent& event) {
-  return {static_cast<const std::uint8_t*>(event.data), static_cast<std::size_t>(std::max(event.datalen, 0))};
-}
-
-void report_unread_tail(lcm::LogFile& log, const std::filesystem::path& path) {
-  const long position = std::ftell(log.getFilePtr());
-  std::error_code error;
-  const auto size = std::filesystem::file_size(path, error);
-  if (!error && position >= 0 && static_cast<std::uintmax_t>(position) < size) {
-    spdlog::warn("{}: log unreadable from byte {} of {} (truncated or corrupt); everything before it was read",
-                 path.string(), position, size);
-  }
-}
-
 bool is_lcm_log(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   unsigned char magic[4] = {};
@@ -46,10 +25,7 @@ bool is_lcm_log(const std::filesystem::path& path) {
 
 LcmLogEventReader::LcmLogEventReader(const std::filesystem::path& path, std::string channel,
                                      Timestamp backwards_slack_us)
-    : path_(path), channel_(std::move(channel)), receiver_(std::nullopt, backwards_slack_us) {
-  log_ = open_lcm_log(path_);
-  std::error_code error;
-  file_size_ = std::filesystem::file_size(path_, error);
+    : path_(path), channel_(std::move(channel)), log_(path), receiver_(std::nullopt, backwards_slack_us) {
   if (!next_batch(first_)) {
     throw std::runtime_error("no valid event batch on " + (channel_.empty() ? std::string("an EVENTS_* channel") : channel_) +
                              " in LCM log " + path_.string());
@@ -60,13 +36,13 @@ LcmLogEventReader::LcmLogEventReader(const std::filesystem::path& path, std::str
 LcmLogEventReader::~LcmLogEventReader() = default;
 
 bool LcmLogEventReader::next_batch(EventBatch& out) {
-  while (const lcm::LogEvent* event = log_->readNextEvent()) {
-    if (!channel_matches(channel_, "EVENTS_", event->channel)) continue;
-    if (!receiver_.receive(log_payload(*event), out)) continue;
-    if (channel_.empty()) channel_ = event->channel;
+  while (log_.next(record_)) {
+    if (!channel_matches(channel_, "EVENTS_", record_.channel)) continue;
+    if (!receiver_.receive(record_.data, out)) continue;
+    if (channel_.empty()) channel_ = record_.channel;
     return true;
   }
-  report_unread_tail(*log_, path_);
+  log_.report();
   return false;
 }
 
@@ -79,13 +55,11 @@ bool LcmLogEventReader::read(EventBatch& out) {
   return next_batch(out);
 }
 
-double LcmLogEventReader::progress() const {
-  const long position = std::ftell(log_->getFilePtr());
-  return file_size_ && position > 0 ? static_cast<double>(position) / static_cast<double>(file_size_) : 0.0;
-}
+double LcmLogEventReader::progress() const { return log_.progress(); }
 
 std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std::string channel) {
-  const auto log = open_lcm_log(path);
+  LcmLogReader log(path);
+  LcmLogReader::Record record;
   std::vector<SegmentRow> rows;
   std::uint64_t invalid = 0;
   segment_list_t msg;
@@ -93,13 +67,13 @@ std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std:
   std::size_t step_begin = 0;
   Timestamp step_t = INT64_MIN;
   bool any_list = false;
-  while (const lcm::LogEvent* event = log->readNextEvent()) {
-    if (!channel_matches(channel, "LINES_", event->channel)) continue;
-    if (decode_message(log_payload(*event), msg) != WireError::None || !read_segment_list(msg, lines)) {
+  while (log.next(record)) {
+    if (!channel_matches(channel, "LINES_", record.channel)) continue;
+    if (decode_message(record.data, msg) != WireError::None || !read_segment_list(msg, lines)) {
       ++invalid;
       continue;
     }
-    if (channel.empty()) channel = event->channel;
+    if (channel.empty()) channel = record.channel;
     any_list = true;
     // Lists are published at a fixed rate: one of the same lattice time as the previous replaces it.
     if (msg.t_us == step_t) {
@@ -115,7 +89,7 @@ std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std:
       rows.push_back({msg.t_us, line.id, line.segment, line.score, line.status});
     }
   }
-  report_unread_tail(*log, path);
+  log.report();
   if (invalid) spdlog::warn("{}: {} invalid segment lists skipped", path.string(), invalid);
   if (!any_list) {
     throw std::runtime_error("no valid segment list on " + (channel.empty() ? std::string("a LINES_* channel") : channel) +

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <string>
 
+#include "evldt/transport/lcm_log_reader.hpp"
+
 namespace evldt {
 
 struct LogExportOptions {
@@ -23,10 +25,11 @@ struct LogExportCounts {
   std::uint64_t images = 0, segment_lists = 0, whole_line_lists = 0, stats = 0;
   std::uint64_t invalid = 0;        ///< messages of the camera's channels that could not be decoded (skipped)
   std::uint64_t other_messages = 0; ///< of other channels or cameras (not exported)
+  LogDamage damage;                 ///< what of the log could not be read (also said in a warning)
 };
 
-/// Writes `mcap` from `log`; a log LCM stops reading early gives what was read before, with a
-/// warning (report_unread_tail). Throws std::runtime_error naming the file for a log that cannot be
+/// Writes `mcap` from `log`; damaged stretches of the log are skipped, counted and said in a warning
+/// (LcmLogReader). Throws std::runtime_error naming the file for a log that cannot be
 /// opened or holds no event batch of the camera, std::invalid_argument for bad options.
 LogExportCounts export_log_to_mcap(const std::filesystem::path& log, const std::filesystem::path& mcap, const LogExportOptions& options);
 

@@ -1,7 +1,8 @@
 #pragma once
-// Reading what lcm-logger recorded, through LCM's own LogFile API: the event batches of one camera
-// as an event stream (so a recorded run can be processed offline) and its segment lists as rows
-// (so a recorded run can be evaluated). Malformed messages are counted and skipped.
+// Reading what lcm-logger recorded (LcmLogReader, which counts and says every damaged stretch): the
+// event batches of one camera as an event stream (so a recorded run can be processed offline) and
+// its segment lists as rows (so a recorded run can be evaluated). Malformed messages are counted and
+// skipped.
 
 #include <cstdint>
 #include <filesystem>
@@ -12,23 +13,12 @@
 
 #include "evldt/lines/segment_csv.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
-
-namespace lcm {
-class LogFile;
-struct LogEvent;
-}
+#include "evldt/transport/lcm_log_reader.hpp"
 
 namespace evldt {
 
 /// True if the file starts like an LCM log (the event sync word 0xEDA1DA01).
 bool is_lcm_log(const std::filesystem::path& path);
-/// Opens an LCM log to read; throws std::runtime_error naming the file if it cannot be opened.
-std::unique_ptr<lcm::LogFile> open_lcm_log(const std::filesystem::path& path);
-/// The bytes of a logged message.
-std::span<const std::uint8_t> log_payload(const lcm::LogEvent& event);
-/// Once reading has stopped: LogFile stops at the first event it cannot read, so this warns, with
-/// the byte, if that was before the end of the file (truncated or corrupt).
-void report_unread_tail(lcm::LogFile& log, const std::filesystem::path& path);
 
 class LcmLogEventReader {
  public:
@@ -47,22 +37,25 @@ class LcmLogEventReader {
   [[nodiscard]] ReceiverCounts counts() const { return receiver_.counts(); }
   /// Fraction of the file read.
   [[nodiscard]] double progress() const;
+  /// What was skipped as damaged so far (said in a warning once the log is read).
+  [[nodiscard]] const LogDamage& damage() const { return log_.damage(); }
 
  private:
   bool next_batch(EventBatch& out);
 
   std::filesystem::path path_;
   std::string channel_;
-  std::unique_ptr<lcm::LogFile> log_;
+  LcmLogReader log_;
+  LcmLogReader::Record record_;
   EventBatchReceiver receiver_;
-  std::uint64_t file_size_ = 0;
   EventBatch first_;  // read while finding the sensor size, handed out by the first read()
   bool first_pending_ = false;
 };
 
 /// The segment lists on `channel` (empty: the first LINES_* channel) as rows, one step per lattice
 /// time (the last list of that time), rows of a step sorted by id. Lists going back in time are
-/// skipped and counted. Throws std::runtime_error if the file cannot be opened or has no valid list.
+/// skipped and counted; damaged stretches of the log are said in a warning. Throws std::runtime_error
+/// if the file cannot be opened or has no valid list.
 std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std::string channel = {});
 
 }  // namespace evldt
