@@ -92,8 +92,11 @@ wait_ready "$work/slow.err" evldt-lines
 wait_until "the probe to subscribe" grep -q '^ready' "$work/probe.out"
 run_camera "$work/camera2.out" &
 camera_pid=$!
+# The stalls start once batches flow (the tracking thread starts with the first): on a busy machine
+# the camera can take over a second to start, and stalls before it would stall nothing.
+wait_until "evldt-lines's tracking thread" tracking_started
 for _ in 1 2; do
-  sleep 0.8
+  sleep 0.5
   kill -STOP "$lines_pid"
   sleep 0.3
   kill -CONT "$lines_pid"
