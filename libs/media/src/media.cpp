@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <spdlog/spdlog.h>
+
 #include "module_api.hpp"
 
 namespace evldt::media {
@@ -18,7 +20,9 @@ std::vector<std::string> module_candidates() {
   if (const char* given = std::getenv("EVLDT_MEDIA_MODULE"); given != nullptr && *given != '\0') candidates.emplace_back(given);
   Dl_info self{};
   if (dladdr(reinterpret_cast<void*>(&module_candidates), &self) != 0 && self.dli_fname != nullptr) {
-    candidates.push_back((std::filesystem::path(self.dli_fname).parent_path() / EVLDT_MEDIA_MODULE_NAME).string());
+    const std::filesystem::path folder = std::filesystem::path(self.dli_fname).parent_path();
+    candidates.push_back((folder / EVLDT_MEDIA_MODULE_NAME).string());
+    candidates.push_back((folder / EVLDT_MEDIA_FROM_BINDIR).lexically_normal().string());
   }
   candidates.emplace_back(EVLDT_MEDIA_BUILD_PATH);
   candidates.emplace_back(EVLDT_MEDIA_INSTALL_PATH);
@@ -40,7 +44,10 @@ const ModuleApi* load_module() {
     using Entry = const ModuleApi* (*)();
     const auto entry = reinterpret_cast<Entry>(dlsym(handle, "evldt_media_module_api"));
     const ModuleApi* api = entry != nullptr ? entry() : nullptr;
-    if (api != nullptr && api->version == ModuleApi::kVersion) return api;  // kept loaded for the process's life
+    if (api != nullptr && api->version == ModuleApi::kVersion) {
+      spdlog::debug("media module {}", path);
+      return api;  // kept loaded for the process's life
+    }
     tried += "\n  " + path + ": not an evldt media module of this build";
     dlclose(handle);
   }

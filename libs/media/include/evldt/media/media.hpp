@@ -2,7 +2,8 @@
 // Image and video files through OpenCV (imwrite, imread, imencode, VideoWriter, VideoCapture),
 // from a module loaded the first time one is used (libs/media/CMakeLists.txt says why). The module
 // is looked for at $EVLDT_MEDIA_MODULE, beside the binary that holds this code (the Python
-// extension carries one), in the build tree, then where it is installed; when none loads, the call
+// extension carries one), where the install rules put it relative to that binary (a package unpacked
+// under another root), in the build tree, then where it is installed; when none loads, the call
 // throws std::runtime_error saying where it looked. OpenCV's constants (cv::IMWRITE_*,
 // cv::IMREAD_*, cv::CAP_*) come from its headers as usual.
 
