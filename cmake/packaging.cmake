@@ -27,6 +27,19 @@ foreach(source ${evldt_deploy_files})
   endif()
 endforeach()
 
+# For programs of one's own (issue 51): a CMake package (find_package(evldt): evldt::lcmtypes,
+# evldt::client) and a pkg-config file, both relocatable (paths relative to where they lie).
+include(CMakePackageConfigHelpers)
+set(evldt_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/evldt)
+file(RELATIVE_PATH EVLDT_CONFIG_TO_PREFIX ${CMAKE_INSTALL_PREFIX}/${evldt_cmake_dir} ${CMAKE_INSTALL_PREFIX})
+configure_file(${PROJECT_SOURCE_DIR}/cmake/evldtConfig.cmake.in ${CMAKE_CURRENT_BINARY_DIR}/evldtConfig.cmake @ONLY)
+write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/evldtConfigVersion.cmake COMPATIBILITY SameMinorVersion)
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/evldtConfig.cmake ${CMAKE_CURRENT_BINARY_DIR}/evldtConfigVersion.cmake
+        DESTINATION ${evldt_cmake_dir})
+file(RELATIVE_PATH EVLDT_PC_TO_PREFIX ${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/pkgconfig ${CMAKE_INSTALL_PREFIX})
+configure_file(${PROJECT_SOURCE_DIR}/cmake/evldt.pc.in ${CMAKE_CURRENT_BINARY_DIR}/evldt.pc @ONLY)
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/evldt.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
 # The Debian package: every install rule but the Python module's (built for the Python that
 # configured the build, not Debian's). Its library dependencies come from dpkg-shlibdeps; the
 # logger unit needs lcm-logger, lcm-spy (deploy/lcm-spy.sh) a Java runtime.
@@ -42,7 +55,8 @@ set(CPACK_INSTALL_CMAKE_PROJECTS "${CMAKE_BINARY_DIR};evldt;Unspecified;/")  # t
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-set(CPACK_DEBIAN_PACKAGE_DEPENDS "liblcm-bin")
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "liblcm-bin")  # lcm-logger; building against the SDK needs liblcm-dev too
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "liblcm-dev")  # to build against the SDK
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "liblcm-java, default-jre-headless, libjchart2d-java")
 # What a robot's administrator edits stays theirs across upgrades.
 set(evldt_conffiles ${CMAKE_CURRENT_BINARY_DIR}/debian/conffiles)

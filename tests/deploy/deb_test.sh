@@ -30,6 +30,11 @@ for path in /usr/bin/evldt-camera /usr/bin/evldt-lines /usr/bin/evldt-viz /usr/b
   /usr/lib/systemd/system/evldt-viz@.service /usr/lib/systemd/system/evldt-logger.service; do
   check "the package holds $path" grep -qx "$path" "$work/contents"
 done
+for path in /usr/include/evldt/segment_list_t.hpp /usr/include/evldt/client/line_subscriber.hpp; do
+  check "the package holds $path" grep -qx "$path" "$work/contents"
+done
+check "the package holds the CMake package" grep -q '^/usr/lib/.*/cmake/evldt/evldtConfig.cmake$' "$work/contents"
+check "the package holds the pkg-config file" grep -q '^/usr/lib/.*/pkgconfig/evldt.pc$' "$work/contents"
 check "the package holds the media module" grep -q '^/usr/lib/.*/evldt/libevldt_media_opencv.so$' "$work/contents"
 if grep -q '^EVLDT_LCMTYPES_JAR' "$build/CMakeCache.txt"; then
   check "the package holds the lcm-spy jar" grep -qx /usr/share/java/evldt_lcmtypes.jar "$work/contents"

@@ -13,6 +13,7 @@
 #include <thread>
 #include <unistd.h>
 
+#include "evldt/client/line_subscriber.hpp"
 #include "evldt/transport/channels.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 #include "evldt/transport/latency_budget.hpp"
@@ -1115,6 +1116,58 @@ TEST_F(LcmLogReaderTest, AnEmptyOrMissingFile) {
   EXPECT_TRUE(read_log(path_).numbers.empty());
   EXPECT_FALSE(read_log(path_).damage.any());
   EXPECT_THROW(LcmLogReader(path_.string() + ".missing"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace evldt
+
+namespace evldt {
+namespace {
+
+// The consumer SDK over an in-process bus: a camera's segments and whole lines as plain structs;
+// another type on its channels counted, not handed on.
+TEST(LineSubscriber, HandsOverSegmentsAndWholeLinesAsPlainStructsAndCountsWhatDoesNotDecode) {
+  lcm::LCM bus("memq://");
+  ASSERT_TRUE(bus.good());
+  std::vector<client::LineList> received;
+  client::LineSubscriber subscriber(bus, "Cam0", [&](const client::LineList& list) { received.push_back(list); });
+  segment_list_t list{};
+  list.source = "cam0";
+  list.width = 240;
+  list.height = 180;
+  list.t_us = 1'600'000'000'123'456;
+  line_segment_t segment{};
+  segment.id = 42;
+  segment.x0 = 1.5f;
+  segment.y0 = 2.5f;
+  segment.x1 = 30.25f;
+  segment.y1 = 40.75f;
+  segment.score = 0.8f;
+  segment.status = line_segment_t::STATUS_GOOD_TRACK;
+  list.segments = {segment};
+  list.num_segments = 1;
+  bus.publish("LINES_CAM0", &list);
+  list.segments.clear();
+  list.num_segments = 0;
+  bus.publish("WHOLE_LINES_CAM0", &list);
+  const std::uint8_t junk[] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+  bus.publish("LINES_CAM0", junk, sizeof junk);
+  bus.publish("LINES_CAM1", &list);  // another camera's
+  for (int k = 0; k < 4; ++k) bus.handleTimeout(100);
+  ASSERT_EQ(received.size(), 2u);
+  EXPECT_FALSE(received[0].whole_lines);
+  EXPECT_EQ(received[0].camera, "cam0");
+  EXPECT_EQ(received[0].width, 240);
+  EXPECT_EQ(received[0].t_us, 1'600'000'000'123'456);
+  ASSERT_EQ(received[0].lines.size(), 1u);
+  const client::Line& line = received[0].lines[0];
+  EXPECT_EQ(line.id, 42);
+  EXPECT_EQ(line.x0, 1.5f);
+  EXPECT_EQ(line.y1, 40.75f);
+  EXPECT_EQ(line.status, client::LineStatus::GoodTrack);
+  EXPECT_TRUE(received[1].whole_lines);
+  EXPECT_TRUE(received[1].lines.empty());
+  EXPECT_EQ(subscriber.undecodable(), 1u);
 }
 
 }  // namespace
