@@ -10,7 +10,9 @@ import os
 import pathlib
 import struct
 import subprocess
+import sys
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -285,3 +287,60 @@ def test_read_frames_gives_the_images_of_an_ecd_folder_and_names_a_bad_one(tmp_p
     (tmp_path / "images.txt").write_text("0.001 images/a.pgm\n0.002 images/gone.pgm\n")
     with pytest.raises(ValueError, match="images.txt:2: frame .*gone.pgm is missing"):
         evldt.read_frames(tmp_path, 64, 48)
+
+
+# --- live lines, received without the lcm Python module (issue 51) -----------------------------------
+LINES = BUILD / "services/evldt-lines/evldt-lines"
+CAMERA = BUILD / "services/evldt-camera/evldt-camera"
+EXAMPLE = pathlib.Path(__file__).resolve().parents[2] / "libs/python/examples/subscribe_lines.py"
+LIVE_URL = "udpm://239.255.76.67:7721?ttl=0"
+
+
+@pytest.fixture()
+def live_lines():
+    """evldt-lines on loopback, ready; a function that runs the camera for 1 s of boxes-6dof."""
+    lines = subprocess.Popen([str(LINES), "--lcm-url", LIVE_URL, "--log-period-s", "0"], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.PIPE, text=True)
+    try:
+        for line in lines.stderr:  # its log, until it is subscribed
+            if "evldt-lines ready:" in line:
+                break
+        threading.Thread(target=lines.stderr.read, daemon=True).start()  # keep the pipe drained
+        yield lambda: run(CAMERA, "--lcm-url", LIVE_URL, "--scene", "boxes-6dof", "--duration-s", "1", "-q")
+    finally:
+        lines.terminate()
+        lines.wait(timeout=30)
+
+
+def test_subscriber_receives_segments_and_whole_lines_as_arrays(live_lines):
+    subscriber = evldt.Subscriber("cam0", LIVE_URL)
+    camera = threading.Thread(target=live_lines)
+    camera.start()
+    received = []
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and (camera.is_alive() or len(received) < 40):
+        lists = subscriber.receive(timeout_s=1)
+        if lists is not None:
+            received.append(lists)
+    camera.join()
+    segments = [lists for lists in received if not lists.whole_lines]
+    whole = [lists for lists in received if lists.whole_lines]
+    assert len(segments) > 20 and len(whole) > 20
+    assert all(lists.camera == "cam0" and lists.lines.dtype == evldt.SEGMENT_DTYPE for lists in received)
+    assert any(len(lists.lines) > 0 for lists in segments) and any(len(lists.lines) > 0 for lists in whole)
+    times = [lists.t_us for lists in segments]
+    assert times == sorted(times)
+    lines = np.concatenate([lists.lines for lists in segments])
+    assert ((lines["x0"] >= 0) & (lines["x0"] <= 240) & (lines["y1"] >= 0) & (lines["y1"] <= 180)).all()
+    assert subscriber.undecodable == 0
+
+
+def test_the_subscriber_example_prints_the_lines_it_receives(live_lines):
+    example = subprocess.Popen([sys.executable, str(EXAMPLE), "cam0", LIVE_URL, "10"], stdout=subprocess.PIPE, text=True,
+                               env=dict(os.environ))
+    assert example.stdout.readline().startswith("ready: listening to camera cam0")
+    live_lines()
+    out, _ = example.communicate(timeout=60)
+    assert example.returncode == 0
+    assert "segments at event time" in out and "whole lines at event time" in out
+    assert "  id " in out

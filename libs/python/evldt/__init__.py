@@ -25,6 +25,7 @@ from .segment_list_t import segment_list_t
 from .stats_t import stats_t
 
 __all__ = ["read", "read_chunks", "read_frames", "read_lcm_log", "Recording", "Pipeline", "evaluate", "simulate", "Simulation",
+           "Subscriber", "LineList",
            "EVENT_DTYPE", "SEGMENT_DTYPE", "GROUND_TRUTH_DTYPE", "STATUS_NAMES", "FormatError", "FrameError", "event_batch_t",
            "line_segment_t", "segment_list_t", "stats_t"]
 
@@ -185,3 +186,40 @@ def read_lcm_log(path):
                 raise FormatError(f"{path}: byte {offset}: the log ends inside a record")
             yield body[:channel_length].decode("utf-8", "replace"), utime, body[channel_length:]
             offset += _LCM_LOG_HEADER.size + channel_length + data_length
+
+
+LineList = namedtuple("LineList", "whole_lines camera t_us lines")
+
+
+class Subscriber:
+    """A camera's segment and whole-line lists from a running evldt-lines, through evldt's C++ consumer
+    SDK (no lcm Python module needed). `url`: an LCM URL, or empty for LCM_DEFAULT_URL / LCM's default.
+
+        for lines in evldt.Subscriber("cam0").lists(timeout_s=5):
+            print(lines.whole_lines, lines.t_us, lines.lines["id"])
+
+    Each list is a LineList: whole_lines (WHOLE_LINES_<CAMERA> or LINES_<CAMERA>), camera, t_us (the
+    lattice state's event time) and lines (SEGMENT_DTYPE; first_seen and last_good are 0)."""
+
+    def __init__(self, camera="cam0", url=""):
+        self._impl = _evldt.Subscriber(str(camera), str(url))
+
+    def receive(self, timeout_s=1.0):
+        """The next list, or None when none came within timeout_s."""
+        received = self._impl.receive(int(timeout_s * 1000))
+        return None if received is None else LineList(*received)
+
+    def lists(self, timeout_s=None):
+        """Yields lists as they come; ends after timeout_s without one (None: never; a running
+        evldt-lines publishes at its output rate, so a silence means it stopped)."""
+        while True:
+            received = self.receive(1.0 if timeout_s is None else timeout_s)
+            if received is not None:
+                yield received
+            elif timeout_s is not None:
+                return
+
+    @property
+    def undecodable(self):
+        """Messages on the camera's channels that did not decode as segment lists."""
+        return self._impl.undecodable

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "evldt/app/pipeline_options.hpp"
+#include "evldt/client/line_subscriber.hpp"
 #include "evldt/app/simulator_options.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/events/event_validator.hpp"
@@ -347,6 +348,40 @@ py::list read_frames(const std::string& path, int width, int height, const std::
   return frames;
 }
 
+// A camera's segments and whole lines from a running evldt-lines (the C++ consumer SDK): no lcm
+// Python module needed (Debian has none).
+class Subscriber {
+ public:
+  Subscriber(const std::string& camera, const std::string& url)
+      : bus_(url), subscriber_(bus_, camera, [this](const client::LineList& list) { pending_.push_back(list); }) {
+    if (!bus_.good()) throw std::runtime_error("cannot open LCM at '" + url + "'");
+  }
+  /// The next list as (whole_lines, camera, t_us, SEGMENT_DTYPE array), or None after `timeout_ms`.
+  py::object receive(int timeout_ms) {
+    if (pending_.empty()) {
+      py::gil_scoped_release released;
+      if (bus_.handleTimeout(timeout_ms) < 0) throw std::runtime_error("LCM failed while waiting");
+    }
+    if (pending_.empty()) return py::none();
+    const client::LineList list = std::move(pending_.front());
+    pending_.erase(pending_.begin());
+    py::array_t<SegmentRecord> lines(static_cast<py::ssize_t>(list.lines.size()));
+    auto out = lines.mutable_unchecked<1>();
+    for (std::size_t i = 0; i < list.lines.size(); ++i) {
+      const client::Line& l = list.lines[i];
+      out(static_cast<py::ssize_t>(i)) = {list.t_us, static_cast<std::uint64_t>(l.id), l.x0, l.y0, l.x1, l.y1, l.score,
+                                          static_cast<std::uint8_t>(l.status), 0, 0};
+    }
+    return py::make_tuple(list.whole_lines, list.camera, list.t_us, lines);
+  }
+  [[nodiscard]] std::uint64_t undecodable() const { return subscriber_.undecodable(); }
+
+ private:
+  lcm::LCM bus_;
+  std::vector<client::LineList> pending_;
+  client::LineSubscriber subscriber_;
+};
+
 }  // namespace
 }  // namespace evldt::python
 
@@ -379,6 +414,11 @@ PYBIND11_MODULE(_evldt, m) {
       .def("process", &Pipeline::process, py::arg("t"), py::arg("x"), py::arg("y"), py::arg("p"))
       .def("segments", &Pipeline::segments)
       .def("counters", &Pipeline::counters);
+
+  py::class_<Subscriber>(m, "Subscriber")
+      .def(py::init<const std::string&, const std::string&>(), py::arg("camera"), py::arg("url") = "")
+      .def("receive", &Subscriber::receive, py::arg("timeout_ms"))
+      .def_property_readonly("undecodable", &Subscriber::undecodable);
 
   m.def("evaluate", &evaluate, py::arg("segments"), py::arg("ground_truth"), py::arg("width"), py::arg("height"),
         py::arg("tolerances"), py::arg("output_period_us"));
