@@ -11,7 +11,7 @@ install(DIRECTORY config/ DESTINATION ${EVLDT_SYSCONF_DIR} FILES_MATCHING PATTER
 
 # deploy/systemd holds the units as a hand install places them (/usr/local/bin, /etc/evldt);
 # installed ones name this prefix's folders.
-file(GLOB evldt_deploy_files ${PROJECT_SOURCE_DIR}/deploy/systemd/*)
+file(GLOB evldt_deploy_files LIST_DIRECTORIES false ${PROJECT_SOURCE_DIR}/deploy/systemd/*)
 set(evldt_units_dir ${CMAKE_CURRENT_BINARY_DIR}/systemd)
 foreach(source ${evldt_deploy_files})
   get_filename_component(name ${source} NAME)
@@ -39,6 +39,10 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/evldtConfig.cmake ${CMAKE_CURRENT_BINA
 file(RELATIVE_PATH EVLDT_PC_TO_PREFIX ${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/pkgconfig ${CMAKE_INSTALL_PREFIX})
 configure_file(${PROJECT_SOURCE_DIR}/cmake/evldt.pc.in ${CMAKE_CURRENT_BINARY_DIR}/evldt.pc @ONLY)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/evldt.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# Sources of live cameras (a RAW stream over TCP, a followed RAW file, DV's and cAER's network
+# output), to copy to <sysconfdir>/evldt/camera-NAME.env.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/deploy/systemd/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples)
 
 # The Debian package: every install rule but the Python module's (built for the Python that
 # configured the build, not Debian's). Its library dependencies come from dpkg-shlibdeps; the
