@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# evldt-camera@ instances for live cameras (issue 51): each example source of deploy/systemd/examples
+# The systemd units (issue 51): evldt-lines@, evldt-viz@ and evldt-logger pass `systemd-analyze
+# verify`, and so do evldt-camera@ instances for live cameras: each example source of deploy/systemd/examples
 # (a RAW stream over TCP, a followed RAW file, DV's AEDAT 4.0 and cAER's AEDAT 3.1 network output)
 # as /etc/evldt/camera-NAME.env: the instance unit passes `systemd-analyze verify`, and its command
 # line, as systemd would expand it (the example's address pointed at a test server), publishes the
@@ -68,7 +69,15 @@ for example in "$examples"/camera-*.env; do
   name=${name//-/_}  # a camera name: letters, digits and '_'
   instance "$name" "$example"
   systemd-analyze verify "$work/units/evldt-camera@$name.service" >"$work/$name.verify" 2>&1
-  check "evldt-camera@$name verifies ($(tr '\n' ' ' <"$work/$name.verify"))" test $? -eq 0
+  check "evldt-camera@$name verifies without a warning ($(tr '\n' ' ' <"$work/$name.verify"))" test $? -eq 0 -a ! -s "$work/$name.verify"
+done
+# The other units, as installed beside them (this build's binaries, the same environment files).
+for unit in evldt-lines@ evldt-viz@ evldt-logger; do
+  service=${unit%@}
+  file=$work/units/${unit}$([[ $unit == *@ ]] && echo cam0).service
+  sed -e "s|/usr/local/bin/$service|$build/services/$service/$service|" -e "s|/etc/evldt/|$work/etc/|g" "$units/$unit.service" >"$file"
+  systemd-analyze verify "$file" >"$work/$service.verify" 2>&1
+  check "$(basename "$file") verifies without a warning ($(tr '\n' ' ' <"$work/$service.verify"))" test $? -eq 0 -a ! -s "$work/$service.verify"
 done
 for name in tcp-raw follow-raw dv libcaer; do  # the example files
   check "an example for $name" test -f "$examples/camera-$name.env"
