@@ -151,6 +151,12 @@ def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
     assert got["lifetime_mean_ms"] == pytest.approx(reference["lifetime"]["mean_ms"])
     assert got["coverage"] == pytest.approx(reference["tracking"]["coverage"])
     assert got["idf1"] == pytest.approx(reference["tracking"]["idf1"])
+    # The same run on a clock of Unix-epoch microseconds, as DV writes them (issue 49): the same figures.
+    epoch = 1_600_000_000_000_000
+    segments["t"] += epoch
+    truth["t"] += epoch
+    shifted = evldt.evaluate(segments, truth, 240, 180)
+    assert shifted == got
 
 
 def test_simulated_ground_truth_equals_evldt_sim_csv(boxes):
