@@ -199,11 +199,7 @@ std::map<Timestamp, std::vector<Segment>> steps_of(const std::vector<SegmentRow>
 // --overlay: the frames with LSD's lines and the lines held at each, as scored.
 void write_overlay_pictures(const Options& options, const StreamEvaluator& scored, const std::vector<SegmentRow>& segments,
                             const std::vector<SegmentRow>& whole_lines, SensorSize sensor) {
-  std::vector<Timestamp> whole_line_times;
-  for (const SegmentRow& row : whole_lines) whole_line_times.push_back(row.t_us);
-  std::sort(whole_line_times.begin(), whole_line_times.end());
-  whole_line_times.erase(std::unique(whole_line_times.begin(), whole_line_times.end()), whole_line_times.end());
-  const Timestamp whole_line_hold = StreamEvaluator::hold_for_period(median_step_spacing(whole_line_times));
+  const Timestamp whole_line_hold = prediction_hold_us(whole_lines, options.output_period_us, scored.ground_truth().times);
   const auto frames = open_frames(options.frames_gt, options.frames_topic, sensor);
   const std::size_t pictures = write_overlays(options.overlay, *frames, scored.ground_truth(), {segments, scored.hold_us()},
                                               {whole_lines, whole_line_hold});

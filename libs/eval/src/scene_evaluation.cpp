@@ -166,16 +166,21 @@ void StreamEvaluator::finish() {
   coverage_.predicted_steps_scored += held_scored_ ? 1 : 0;
 }
 
+Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_period_us, std::span<const Timestamp> truth_times) {
+  std::vector<Timestamp> times;
+  for (const SegmentRow& row : rows) times.push_back(row.t_us);
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  Timestamp period = output_period_us > 0 ? output_period_us : median_step_spacing(times);
+  if (period == 0) period = median_step_spacing(truth_times);  // fewer than two predicted steps
+  return StreamEvaluator::hold_for_period(period);
+}
+
 StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthSteps truth, SensorSize sensor,
                                       std::vector<double> tolerance_fractions, Timestamp output_period_us) {
   std::stable_sort(rows.begin(), rows.end(), [](const SegmentRow& a, const SegmentRow& b) { return a.t_us < b.t_us; });
-  std::vector<Timestamp> times;
-  for (const SegmentRow& row : rows) {
-    if (times.empty() || times.back() != row.t_us) times.push_back(row.t_us);
-  }
-  Timestamp period = output_period_us > 0 ? output_period_us : median_step_spacing(times);
-  if (period == 0) period = median_step_spacing(truth.times);  // fewer than two predicted steps
-  StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth), StreamEvaluator::hold_for_period(period));
+  const Timestamp hold_us = prediction_hold_us(rows, output_period_us, truth.times);
+  StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth), hold_us);
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted;
   for (std::size_t i = 0; i < rows.size();) {

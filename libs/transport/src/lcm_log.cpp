@@ -25,10 +25,10 @@ bool is_lcm_log(const std::filesystem::path& path) {
 
 LcmLogEventReader::LcmLogEventReader(const std::filesystem::path& path, std::string channel,
                                      Timestamp backwards_slack_us)
-    : path_(path), channel_(std::move(channel)), log_(path), receiver_(std::nullopt, backwards_slack_us) {
+    : channel_(std::move(channel)), log_(path), receiver_(std::nullopt, backwards_slack_us) {
   if (!next_batch(first_)) {
     throw std::runtime_error("no valid event batch on " + (channel_.empty() ? std::string("an EVENTS_* channel") : channel_) +
-                             " in LCM log " + path_.string());
+                             " in LCM log " + log_.path().string());
   }
   first_pending_ = true;
 }

@@ -114,6 +114,10 @@ class StreamEvaluator {
 /// ground-truth steps with StreamEvaluator's rule and a hold of kHoldPeriods output periods.
 /// output_period_us 0: the median spacing of the predicted steps (of the ground truth's, with fewer
 /// than two).
+/// How long a predicted step of `rows` (any order) holds when scored: StreamEvaluator::kHoldPeriods of
+/// `output_period_us`, else of the median spacing of their steps, else (fewer than two steps) of the
+/// ground truth's.
+Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_period_us, std::span<const Timestamp> truth_times);
 StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthSteps truth, SensorSize sensor,
                                       std::vector<double> tolerance_fractions, Timestamp output_period_us);
 

@@ -43,7 +43,6 @@ class LcmLogEventReader {
  private:
   bool next_batch(EventBatch& out);
 
-  std::filesystem::path path_;
   std::string channel_;
   LcmLogReader log_;
   LcmLogReader::Record record_;
