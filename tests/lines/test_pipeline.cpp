@@ -36,8 +36,8 @@ struct Observation {
 std::vector<Observation> run(const EventBatch& events, const PipelineConfig& config, Timestamp step_us) {
   DeterministicPipeline pipeline(config);
   std::vector<Observation> seen;
-  pipeline.set_output(step_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
-    for (const TrackedLine& line : lines.lines()) seen.push_back({t, line});
+  pipeline.set_output(step_us, [&](const OutputStep& step) {
+    for (const TrackedLine& line : step.segments.lines()) seen.push_back({step.t, line});
   });
   pipeline.process(events);
   return seen;
@@ -111,9 +111,9 @@ TEST(Pipeline, OneTwoAndFourThreadsGiveTheSameOutput) {
     DeterministicPipeline pipeline(config);
     auto& seen = by_threads[threads];
     std::size_t most_lines = 0;
-    pipeline.set_output(2000, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
-      most_lines = std::max(most_lines, lines.lines().size());
-      for (const TrackedLine& line : lines.lines()) seen.push_back({t, line});
+    pipeline.set_output(2000, [&](const OutputStep& step) {
+      most_lines = std::max(most_lines, step.segments.lines().size());
+      for (const TrackedLine& line : step.segments.lines()) seen.push_back({step.t, line});
     });
     pipeline.process(events);
     ASSERT_GE(most_lines, 4 * LineTracker::kMinLinesToSplit);
@@ -160,7 +160,7 @@ TEST(Pipeline, RoundsRunOnEventTimeAndLongGapsAreSkipped) {
   config.schedule.detect_period_us = 2000;
   DeterministicPipeline pipeline(config);
   std::vector<Timestamp> steps;
-  pipeline.set_output(1000, [&](Timestamp t, const LineMap&, const ScarfLattice&) { steps.push_back(t); });
+  pipeline.set_output(1000, [&](const OutputStep& step) { steps.push_back(step.t); });
   EventBatch batch;
   batch.push_back(0, 50, 50, 1);
   batch.push_back(4500, 50, 50, 1);        // rounds at 1000..4000
@@ -178,7 +178,7 @@ TEST(Pipeline, RoundsRunOnEventTimeAndLongGapsAreSkipped) {
 TEST(Pipeline, OutputStepsFallOnMultiplesOfThePeriodWhateverTheFirstEventTime) {
   DeterministicPipeline pipeline(unfiltered());
   std::vector<Timestamp> steps;
-  pipeline.set_output(1000, [&](Timestamp t, const LineMap&, const ScarfLattice&) { steps.push_back(t); });
+  pipeline.set_output(1000, [&](const OutputStep& step) { steps.push_back(step.t); });
   EventBatch batch;
   batch.push_back(1234, 50, 50, 1);
   batch.push_back(4100, 50, 50, 1);

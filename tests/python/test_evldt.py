@@ -8,6 +8,7 @@ import csv
 import json
 import os
 import pathlib
+import re
 import struct
 import subprocess
 import sys
@@ -70,16 +71,8 @@ def test_chunks_join_to_the_whole_recording(boxes):
     np.testing.assert_array_equal(np.concatenate(chunks), evldt.read(path).events)
 
 
-def test_pipeline_output_equals_evldt_offline_csv(boxes, tmp_path):
-    path = recording(boxes, "evt3")
-    run(OFFLINE, path, "-o", tmp_path / "segments.csv", "-q")
-    expected = read_csv(tmp_path / "segments.csv")
-    rec = evldt.read(path)
-    pipeline = evldt.Pipeline(rec.width, rec.height)
-    # In uneven slices, as a stream arrives: the output may not depend on how the events are cut.
-    cuts = [0, 1, 777, 50_000, 123_457, len(rec.events)]
-    got = np.concatenate([pipeline.process(rec.events[a:b]) for a, b in zip(cuts, cuts[1:])])
-    assert len(expected) > 1000
+def assert_rows_equal(got, expected):
+    """SEGMENT_DTYPE rows against the rows of a segment CSV, to the CSV's precision."""
     assert len(got) == len(expected)
     np.testing.assert_array_equal(got["t"], [int(r["t_us"]) for r in expected])
     np.testing.assert_array_equal(got["id"], [int(r["id"]) for r in expected])
@@ -87,9 +80,48 @@ def test_pipeline_output_equals_evldt_offline_csv(boxes, tmp_path):
         np.testing.assert_allclose(got[field], [float(r[field]) for r in expected], rtol=0, atol=5.1e-4)
     np.testing.assert_allclose(got["score"], [float(r["score"]) for r in expected], rtol=0, atol=5.1e-5)
     assert [evldt.STATUS_NAMES[s] for s in got["status"]] == [r["status"] for r in expected]
+
+
+def test_pipeline_output_equals_evldt_offline_csv(boxes, tmp_path):
+    path = recording(boxes, "evt3")
+    run(OFFLINE, path, "-o", tmp_path / "segments.csv", "--whole-lines", tmp_path / "whole.csv", "-q")
+    expected = read_csv(tmp_path / "segments.csv")
+    expected_whole = read_csv(tmp_path / "whole.csv")
+    rec = evldt.read(path)
+    pipeline = evldt.Pipeline(rec.width, rec.height, whole_lines=True)
+    # In uneven slices, as a stream arrives: the output may not depend on how the events are cut.
+    cuts = [0, 1, 777, 50_000, 123_457, len(rec.events)]
+    got, got_whole = [], []
+    for a, b in zip(cuts, cuts[1:]):
+        got.append(pipeline.process(rec.events[a:b]))
+        got_whole.append(pipeline.whole_lines())
+    got, got_whole = np.concatenate(got), np.concatenate(got_whole)
+    assert len(expected) > 1000 and len(expected_whole) > 100
+    assert_rows_equal(got, expected)
     assert (got["first_seen"] <= got["t"]).all() and (got["last_good"] <= got["t"]).all()
+    # The whole lines: fewer rows than segments, each joining at least one segment.
+    assert_rows_equal(got_whole, expected_whole)
+    assert len(got_whole) < len(got) and (got_whole["score"] >= 1).all()
     live = pipeline.segments()
     assert len(live) == pipeline.counters()["lines_live"] > 0
+
+
+def test_whole_lines_example_draws_or_prints_them(tmp_path):
+    example = pathlib.Path(__file__).resolve().parents[2] / "libs/python/examples/plot_whole_lines.py"
+    out = run(sys.executable, example, "boxes-6dof", "0.5", tmp_path / "whole.png").stdout
+    joined = re.search(r"(\d+) whole lines joining (\d+) of (\d+) segments", out)
+    assert joined and 0 < int(joined[1]) < int(joined[2]) <= int(joined[3]), out
+    if "matplotlib is not installed" in out:
+        assert len(re.findall(r"^ +\d+  \(", out, re.M)) == int(joined[1]), out
+    else:
+        assert (tmp_path / "whole.png").stat().st_size > 10_000
+
+
+def test_pipeline_without_whole_lines_gives_none(boxes):
+    events = evldt.read(recording(boxes, "evt3")).events
+    pipeline = evldt.Pipeline(240, 180)
+    assert len(pipeline.process(events)) > 1000
+    assert len(pipeline.whole_lines()) == 0
 
 
 def test_pipeline_takes_separate_columns_and_is_deterministic(boxes):

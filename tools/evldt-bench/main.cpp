@@ -24,7 +24,7 @@
 #include "evldt/filters/filter_chain.hpp"
 #include "evldt/sources/event_source.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
-#include "evldt/lines/whole_lines.hpp"
+#include "evldt/lines/whole_line_stage.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
@@ -198,8 +198,8 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   // The passes run on the state at the end of the window; the whole-line steps on its output steps.
   DeterministicPipeline busy(config);
   std::vector<std::pair<Timestamp, std::vector<TrackedLine>>> output_steps;
-  busy.set_output(10000, [&](Timestamp t, const LineMap& lines, const ScarfLattice&) {
-    output_steps.emplace_back(t, std::vector<TrackedLine>(lines.lines().begin(), lines.lines().end()));
+  busy.set_output(10000, [&](const OutputStep& step) {
+    output_steps.emplace_back(step.t, std::vector<TrackedLine>(step.segments.lines().begin(), step.segments.lines().end()));
   });
   busy.process(events);
   const ScarfLattice& state = busy.lattice();
@@ -231,11 +231,11 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   BenchSettings replays = settings;
   replays.min_time_s = 0;  // a replay of every step is long enough
   f.whole = per_item(time_op(replays, [&] {
-                       WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
+                       WholeLineStage whole(config);
                        // Against the lattice at the window's end, as the service checks its gaps,
                        // corners and remembered ends against its latest copy.
-                       for (const auto& [t, lines] : output_steps) joiner.update(t, lines, &state);
-                       f.whole_lines = static_cast<double>(joiner.lines().size());
+                       for (const auto& [t, lines] : output_steps) whole.step(t, lines, &state);
+                       f.whole_lines = static_cast<double>(whole.lines().size());
                      }),
                      static_cast<double>(std::max<std::size_t>(output_steps.size(), 1)));
 

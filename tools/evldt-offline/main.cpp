@@ -14,7 +14,6 @@
 #include "evldt/events/event_validator.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/lines/segment_csv.hpp"
-#include "evldt/lines/whole_lines.hpp"
 #include "evldt/render/frame_writer.hpp"
 #include "evldt/render/line_picture.hpp"
 #include "evldt/sources/read_ahead.hpp"
@@ -84,18 +83,14 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   SegmentCsvWriter csv(options.output);
   std::optional<SegmentCsvWriter> whole_csv;
   if (!options.whole_lines.empty()) whole_csv.emplace(options.whole_lines);
-  WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
-  std::vector<TrackedLine> joined;
-  const bool join = whole_csv || frames.draws_whole_lines();
-  pipeline.set_output(options.output_period_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice& lattice) {
-    csv.write_step(t, lines.lines());
-    if (join) {
-      joiner.update(t, lines.lines(), &lattice);
-      as_tracked_lines(joiner.lines(), joined);
-    }
-    if (whole_csv) whole_csv->write_step(t, joined);
-    frames.step(t, lines, joined, lattice);
-  });
+  pipeline.set_output(
+      options.output_period_us,
+      [&](const OutputStep& step) {
+        csv.write_step(step.t, step.segments.lines());
+        if (whole_csv) whole_csv->write_step(step.t, step.whole_lines);
+        frames.step(step.t, step.segments, step.whole_lines, step.lattice);
+      },
+      /*whole_lines=*/whole_csv || frames.draws_whole_lines());
 
   spdlog::info("{}: {}x{}, b={} N={} dq={} f_th={}", source.name(), sensor->width, sensor->height, config.lattice.block_size, pipeline.lattice().geometry().capacity,
                config.track.perturbation_px, config.score.fit_threshold);
@@ -137,7 +132,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   if (whole_csv) {
     whole_csv->close();
     summary.whole_lines_path = options.whole_lines.string();
-    summary.whole_lines_created = joiner.created();
+    summary.whole_lines_created = pipeline.whole_lines()->created();
     summary.whole_line_rows = whole_csv->rows();
   }
 

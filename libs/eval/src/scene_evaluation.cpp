@@ -9,7 +9,6 @@
 #include <string>
 
 #include "evldt/events/event_validator.hpp"
-#include "evldt/lines/whole_lines.hpp"
 
 namespace evldt {
 
@@ -221,8 +220,6 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
   EventSimulator simulator(scene, sim);
   EventValidator validator(scene.sensor, 0);
   DeterministicPipeline pipeline(config);
-  WholeLineTracker joiner(config.lattice.block_size, config.whole_lines);
-  std::vector<TrackedLine> joined;
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted, step_segments;
   WholeLineSupport support;
@@ -235,15 +232,16 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
     }
     to.add_prediction(t, ids, predicted);
   };
-  pipeline.set_output(step_us, [&](Timestamp t, const LineMap& lines, const ScarfLattice& lattice) {
-    add(evaluator, t, lines.lines());
-    if (whole_lines == nullptr) return;
-    joiner.update(t, lines.lines(), &lattice);
-    as_tracked_lines(joiner.lines(), joined);
-    predicted.swap(step_segments);  // the segments' geometry, which add() made, for the support
-    add(*whole_lines, t, joined);
-    support.add_step(predicted, step_segments);
-  });
+  pipeline.set_output(
+      step_us,
+      [&](const OutputStep& step) {
+        add(evaluator, step.t, step.segments.lines());
+        if (whole_lines == nullptr) return;
+        predicted.swap(step_segments);  // the segments' geometry, which add() made, for the support
+        add(*whole_lines, step.t, step.whole_lines);
+        support.add_step(predicted, step_segments);
+      },
+      /*whole_lines=*/whole_lines != nullptr);
   SceneRunResult result;
   EventBatch batch;
   while (true) {

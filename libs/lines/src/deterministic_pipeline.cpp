@@ -19,10 +19,12 @@ DeterministicPipeline::DeterministicPipeline(const PipelineConfig& config, bool 
   }
 }
 
-void DeterministicPipeline::set_output(Timestamp period_us, StepCallback on_step) {
+void DeterministicPipeline::set_output(Timestamp period_us, StepCallback on_step, bool whole_lines) {
   if (period_us < 0) throw std::invalid_argument("output period must not be negative");
   output_period_ = period_us;
   on_step_ = std::move(on_step);
+  whole_lines_.reset();
+  if (whole_lines) whole_lines_.emplace(config_);
   if (started_) update_next_due();
 }
 
@@ -119,7 +121,9 @@ void DeterministicPipeline::run_rounds_until(Timestamp t) {
       ++counters_.detect_rounds;
     }
     if (output_period_ > 0 && next_output_ == now) {
-      if (on_step_) on_step_(now, lines_, lattice_);
+      const std::span<const TrackedLine> whole =
+          whole_lines_ ? whole_lines_->step(now, lines_.lines(), &lattice_) : std::span<const TrackedLine>{};
+      if (on_step_) on_step_({now, lines_, whole, lattice_});
       next_output_ += output_period_;
     }
     update_next_due();

@@ -529,17 +529,4 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   event_pixels_.reset(nullptr);
 }
 
-void as_tracked_lines(std::span<const WholeLine> lines, std::vector<TrackedLine>& out) {
-  out.clear();
-  for (const WholeLine& l : lines) {
-    out.push_back({.id = l.id,
-                   .segment = l.segment,
-                   .score = static_cast<float>(l.segments),
-                   .status = LineStatus::GoodTrack,
-                   .admin_block = -1,
-                   .first_seen_us = l.first_seen_us,
-                   .last_good_us = l.last_seen_us});
-  }
-}
-
 }  // namespace evldt

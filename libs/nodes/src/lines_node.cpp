@@ -348,15 +348,13 @@ void LinesNode::publish_whole_lines() {
   // A new engine (camera restart, clock back) starts its whole lines afresh; ids go on, never repeated.
   if (step.engine != joined_engine_ || (joiner_ && step.header.t_us < joiner_->last_time())) {
     if (joiner_) next_whole_id_ += joiner_->created();
-    joiner_.emplace(engine.geometry().block_size, engine.config().whole_lines, next_whole_id_);
+    joiner_.emplace(engine.config(), next_whole_id_);
     joined_engine_ = step.engine;
     const LatticeParams& lattice = engine.config().lattice;
     whole_view_.emplace(lattice.sensor, lattice.block_size, lattice.alpha);
   }
   engine.copy_lattice(*whole_view_);  // the events gaps are checked against
-  joiner_->update(step.header.t_us, step.lines, &*whole_view_);
-  as_tracked_lines(joiner_->lines(), whole_);
-  fill_segment_list(whole_, whole_msg_);
+  fill_segment_list(joiner_->step(step.header.t_us, step.lines, &*whole_view_), whole_msg_);
   fill_header(step.header, whole_seq_++, whole_msg_);  // that of the segment list the step was made of
   lcm_.publish(whole_lines_channel_, &whole_msg_);
 }

@@ -3,9 +3,10 @@ simulator of the C++ core, on numpy arrays; and the LCM message types (evldt.seg
 
     import evldt
     events, width, height, fmt = evldt.read("recording.raw")
-    pipeline = evldt.Pipeline(width, height)
+    pipeline = evldt.Pipeline(width, height, whole_lines=True)
     steps = pipeline.process(events)          # the segments of every 10 ms output step
     print(steps[steps["t"] == steps["t"].max()])
+    whole = pipeline.whole_lines()            # the whole lines of the same steps, with their ids
 
 Parameters are the command-line flags of the tools, with underscores (block_size=14 is
 --block-size 14) and checked as the tools check them; a bad one raises ValueError with their
@@ -98,12 +99,14 @@ class Pipeline:
     """The deterministic pipeline of evldt-offline (validation, noise filters, SCARF storage,
     detection, tracking) for a width x height sensor. process() returns the segments of each output
     step (every output_period_us of event time) the events completed, as a SEGMENT_DTYPE array:
-    the rows evldt-offline writes to its CSV for the same events and parameters."""
+    the rows evldt-offline writes to its CSV for the same events and parameters. With
+    whole_lines=True, whole_lines() then returns the whole lines of those steps: the rows of
+    evldt-offline's --whole-lines CSV (score = the block segments joined)."""
 
-    def __init__(self, width, height, output_period_us=10_000, config=None, **params):
+    def __init__(self, width, height, output_period_us=10_000, config=None, whole_lines=False, **params):
         if config is not None:
             params["config"] = str(config)
-        self._impl = _evldt.Pipeline(int(width), int(height), _flags(params), int(output_period_us))
+        self._impl = _evldt.Pipeline(int(width), int(height), _flags(params), int(output_period_us), bool(whole_lines))
 
     def process(self, events, x=None, y=None, p=None):
         """process(events) with a structured array (fields t, x, y, p), or process(t, x, y, p)."""
@@ -120,6 +123,11 @@ class Pipeline:
     def segments(self):
         """The live segments now (SEGMENT_DTYPE, t = the newest event time)."""
         return self._impl.segments()
+
+    def whole_lines(self):
+        """The whole lines of the output steps the last process() call completed (SEGMENT_DTYPE,
+        by step and id); empty unless made with whole_lines=True."""
+        return self._impl.whole_lines()
 
     def counters(self):
         """Events accepted and dropped, rounds run, lines created and live."""

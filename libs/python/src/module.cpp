@@ -97,7 +97,7 @@ py::array_t<EventRecord> events_to_numpy(const EventBatch& batch) {
 }
 
 /// A step's lines, by id as in evldt-offline's CSV.
-void append_lines(Timestamp t, const std::vector<TrackedLine>& lines, std::vector<SegmentRecord>& out) {
+void append_lines(Timestamp t, std::span<const TrackedLine> lines, std::vector<SegmentRecord>& out) {
   const std::size_t first = out.size();
   for (const TrackedLine& line : lines) {
     out.push_back({t, line.id, line.segment.q0.x(), line.segment.q0.y(), line.segment.q1.x(), line.segment.q1.y(),
@@ -164,10 +164,11 @@ class Reader {
 };
 
 /// The deterministic pipeline behind evldt-offline: validation, noise filters, storage, detection
-/// and tracking, with an output step every output_period_us of event time.
+/// and tracking, with an output step every output_period_us of event time; with whole_lines, each
+/// step's whole lines too (evldt-offline's --whole-lines).
 class Pipeline {
  public:
-  Pipeline(int width, int height, const std::vector<std::string>& flags, Timestamp output_period_us) {
+  Pipeline(int width, int height, const std::vector<std::string>& flags, Timestamp output_period_us, bool whole_lines) {
     PipelineOptions options;
     parse_flags("evldt.Pipeline", flags, [&](CLI::App& app) { options.add_to(app); });
     const SensorSize sensor{width, height};
@@ -177,9 +178,13 @@ class Pipeline {
     const PipelineConfig config = options.resolve(sensor);  // std::invalid_argument -> ValueError
     validator_.emplace(sensor, options.time_slack_us());
     pipeline_.emplace(config);
-    pipeline_->set_output(output_period_us, [this](Timestamp t, const LineMap& lines, const ScarfLattice&) {
-      append_lines(t, lines.lines(), steps_);
-    });
+    pipeline_->set_output(
+        output_period_us,
+        [this](const OutputStep& step) {
+          append_lines(step.t, step.segments.lines(), steps_);
+          append_lines(step.t, step.whole_lines, whole_steps_);
+        },
+        whole_lines);
     staging_.reserve(kStagingEvents);
   }
 
@@ -201,6 +206,7 @@ class Pipeline {
       py::gil_scoped_release unlocked;  // the arrays stay alive: the caller holds them
       std::lock_guard lock(mutex_);
       steps_.clear();
+      whole_steps_.clear();
       for (py::ssize_t begin = 0; begin < n; begin += static_cast<py::ssize_t>(kStagingEvents)) {
         const py::ssize_t end = std::min(n, begin + static_cast<py::ssize_t>(kStagingEvents));
         staging_.clear();
@@ -209,8 +215,16 @@ class Pipeline {
         pipeline_->process(staging_);
       }
       completed.swap(steps_);
+      completed_whole_.swap(whole_steps_);
     }
     return to_numpy(completed);
+  }
+
+  /// The whole lines of the output steps the last process() call completed (empty unless the
+  /// pipeline was made with whole_lines).
+  py::array_t<SegmentRecord> whole_lines() const {
+    std::lock_guard lock(mutex_);
+    return to_numpy(completed_whole_);
   }
 
   /// The live lines now, stamped with the newest event time seen.
@@ -250,7 +264,8 @@ class Pipeline {
   std::optional<EventValidator> validator_;
   std::optional<DeterministicPipeline> pipeline_;
   EventBatch staging_;
-  std::vector<SegmentRecord> steps_;
+  std::vector<SegmentRecord> steps_, whole_steps_;
+  std::vector<SegmentRecord> completed_whole_;  // whole_steps_ of the last process()
 };
 
 py::dict prf_dict(const Prf& prf) {
@@ -409,10 +424,11 @@ PYBIND11_MODULE(_evldt, m) {
       .def_property_readonly("progress", &Reader::progress);
 
   py::class_<Pipeline>(m, "Pipeline")
-      .def(py::init<int, int, const std::vector<std::string>&, Timestamp>(), py::arg("width"), py::arg("height"),
-           py::arg("flags"), py::arg("output_period_us"))
+      .def(py::init<int, int, const std::vector<std::string>&, Timestamp, bool>(), py::arg("width"), py::arg("height"),
+           py::arg("flags"), py::arg("output_period_us"), py::arg("whole_lines") = false)
       .def("process", &Pipeline::process, py::arg("t"), py::arg("x"), py::arg("y"), py::arg("p"))
       .def("segments", &Pipeline::segments)
+      .def("whole_lines", &Pipeline::whole_lines)
       .def("counters", &Pipeline::counters);
 
   py::class_<Subscriber>(m, "Subscriber")

@@ -135,7 +135,7 @@ struct SceneRunResult {
 /// Simulates the scene, runs the deterministic pipeline on it with an output every step_us and scores
 /// it on the scene's ground-truth steps (scene_ground_truth_steps) with a hold of
 /// kHoldPeriods * step_us. `evaluator` must have been made for those steps; so must `whole_lines`,
-/// which, when given, scores the whole lines (WholeLineTracker, config.whole_lines) of each output
+/// which, when given, scores the whole lines (WholeLineStage, config.whole_lines) of each output
 /// and measures their support by the segments (WholeLineSupport's defaults).
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
                               Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines = nullptr);

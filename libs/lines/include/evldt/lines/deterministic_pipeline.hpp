@@ -1,13 +1,17 @@
 #pragma once
-// The deterministic pipeline (DESIGN 6): the noise filters, storage of every event that passes them,
-// tracking every track_period_us and detection every detect_period_us of EVENT time, so a run's
-// output depends only on its input.
+// The deterministic pipeline (DESIGN 6), its stages composed in this one place: the noise filters,
+// storage of every event that passes them in the lattice, tracking every track_period_us and
+// detection every detect_period_us of EVENT time, and at each output step, when asked for, the
+// whole lines; so a run's output depends only on its input.
 
 #include <cstdint>
 #include <functional>
+#include <optional>
+#include <span>
 
 #include "evldt/lines/detector.hpp"
 #include "evldt/lines/tracker.hpp"
+#include "evldt/lines/whole_line_stage.hpp"
 
 namespace evldt {
 
@@ -23,16 +27,24 @@ struct PipelineCounters {
 /// only lets that through when it follows a clock reset): the round schedule begins again there.
 inline constexpr Timestamp kClockStepBackUs = 1'000'000;
 
+/// The state after every round due at an output step's time.
+struct OutputStep {
+  Timestamp t;
+  const LineMap& segments;
+  std::span<const TrackedLine> whole_lines;  ///< empty unless whole lines were asked for
+  const ScarfLattice& lattice;
+};
+
 class DeterministicPipeline {
  public:
-  /// Called at each output step with the state after every round due at that time.
-  using StepCallback = std::function<void(Timestamp step_time, const LineMap& lines, const ScarfLattice& lattice)>;
+  using StepCallback = std::function<void(const OutputStep& step)>;
 
   explicit DeterministicPipeline(const PipelineConfig& config, bool keep_surface = false);
 
   /// Adds an output step at every multiple of period_us of event time after the first event (0
   /// disables it): the steps fall on the same clock grid as ground truth sampled every period_us.
-  void set_output(Timestamp period_us, StepCallback on_step);
+  /// With whole_lines, each step also joins its segments into whole lines (WholeLineStage).
+  void set_output(Timestamp period_us, StepCallback on_step, bool whole_lines = false);
 
   /// Feeds on-sensor events in time order (an EventValidator upstream guarantees both) through the
   /// filters into storage. A round due at time T sees exactly the stored events with t < T. After a
@@ -53,6 +65,8 @@ class DeterministicPipeline {
   [[nodiscard]] FilterCounts filter_counts() const { return filters_.counts(); }
   [[nodiscard]] const FilterChain& filters() const { return filters_; }
   [[nodiscard]] const PipelineConfig& config() const { return config_; }
+  /// The whole-line stage, when set_output asked for whole lines.
+  [[nodiscard]] const WholeLineStage* whole_lines() const { return whole_lines_ ? &*whole_lines_ : nullptr; }
 
  private:
   void store(const EventBatch& batch);
@@ -70,6 +84,7 @@ class DeterministicPipeline {
   LineDetector detector_;
   LineTracker tracker_;
   PipelineCounters counters_;
+  std::optional<WholeLineStage> whole_lines_;
   StepCallback on_step_;
   Timestamp output_period_ = 0;
   bool started_ = false;

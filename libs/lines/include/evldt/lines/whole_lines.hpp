@@ -161,8 +161,4 @@ class WholeLineTracker {
   std::vector<Segment> reached_;
 };
 
-/// Whole lines as rows of the segment format (segment_csv.hpp): score = the number of block segments
-/// joined, status good, admin block -1.
-void as_tracked_lines(std::span<const WholeLine> lines, std::vector<TrackedLine>& out);
-
 }  // namespace evldt

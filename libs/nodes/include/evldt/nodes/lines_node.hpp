@@ -20,7 +20,7 @@
 #include <sys/types.h>
 
 #include "evldt/lines/realtime_engine.hpp"
-#include "evldt/lines/whole_lines.hpp"
+#include "evldt/lines/whole_line_stage.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 #include "evldt/transport/latency_tracker.hpp"
 #include "evldt/transport/payload_queue.hpp"
@@ -169,11 +169,10 @@ class LinesNode {
 
   // Whole-line thread only.
   WholeLineStep whole_step_;
-  std::optional<WholeLineTracker> joiner_;  ///< for the engine below (held, so a new one is told apart)
+  std::optional<WholeLineStage> joiner_;  ///< for the engine below (held, so a new one is told apart)
   std::shared_ptr<const RealtimeEngine> joined_engine_;
   std::optional<ScarfLattice> whole_view_;  ///< the joined engine's lattice as of the last whole-line step
   std::uint64_t next_whole_id_;
-  std::vector<TrackedLine> whole_;
   segment_list_t whole_msg_;
   std::int64_t whole_seq_ = 0;
 };
