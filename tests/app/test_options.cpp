@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 
+#include "evldt/app/parameters.hpp"
 #include "evldt/app/pipeline_options.hpp"
 
 namespace evldt {
@@ -81,6 +83,86 @@ TEST(PipelineOptions, BadValuesAndUnknownKeysAreRefused) {
   ASSERT_EQ(parse({"--width", "640"}, half), 0);
   EXPECT_THROW(static_cast<void>(half.sensor()), std::invalid_argument);
   std::filesystem::remove_all(dir);
+}
+
+TEST(Parameters, TheConfigurationPageIsTheTablesOwn) {
+  std::ifstream file(EVLDT_SOURCE_DIR "/docs/configuration.md");
+  ASSERT_TRUE(file) << "docs/configuration.md is missing";
+  const std::string page((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(page, configuration_page())
+      << "docs/configuration.md differs from the parameter table: write it again with\n"
+         "  evldt-config --markdown > docs/configuration.md";
+}
+
+TEST(Parameters, EachSetsItsOwnFieldAndNoOther) {
+  const SensorSize sensor{640, 480};
+  const PipelineConfig defaults = PipelineOptions{}.resolve(sensor);
+  const std::span<const Parameter> parameters = pipeline_parameters();
+  for (const Parameter& parameter : parameters) {
+    if (std::holds_alternative<std::monostate>(parameter.field)) continue;
+    // A value other than the default, within the range: the lowest, else the highest (some bound
+    // others: the flicker band's lowest stays below its highest).
+    const std::string old_value = parameter.value_in(defaults);
+    std::vector<std::string> candidates;
+    if (parameter.type == Parameter::Type::Text) {
+      candidates.push_back(parameter.choices.empty() ? "none" : std::string(parameter.choices.back()));
+      if (!parameter.choices.empty()) candidates.push_back(std::string(parameter.choices.front()));
+    } else {
+      const auto text = [](double number) {
+        char out[32];
+        return std::string(out, std::to_chars(out, out + sizeof out, number).ptr);
+      };
+      if (!parameter.above_min) candidates.push_back(text(parameter.min));
+      candidates.push_back(text(parameter.max));
+    }
+    std::string value;
+    PipelineConfig config;
+    for (const std::string& candidate : candidates) {
+      if (candidate == old_value) continue;
+      PipelineOptions options;
+      ASSERT_EQ(parse({"--" + std::string(parameter.flag), candidate}, options), 0) << parameter.flag << " " << candidate;
+      try {
+        config = options.resolve(sensor);
+      } catch (const std::invalid_argument&) {
+        continue;
+      }
+      value = candidate;
+      break;
+    }
+    ASSERT_FALSE(value.empty()) << parameter.flag << ": no value other than the default resolves";
+    for (const Parameter& other : parameters) {
+      if (&other == &parameter) {
+        EXPECT_EQ(other.value_in(config), value) << other.flag;
+      } else {
+        EXPECT_EQ(other.value_in(config), other.value_in(defaults)) << "--" << parameter.flag << " changed " << other.flag;
+      }
+    }
+  }
+}
+
+TEST(Parameters, TheShippedConfigsStateTheDefaultsOfTheirSize) {
+  for (const char* file : {"240x180.toml", "346x260.toml", "640x480.toml", "1280x720.toml"}) {
+    PipelineOptions options;
+    ASSERT_EQ(parse({"--config", (kConfigDir / file).string()}, options), 0) << file;
+    const SensorSize sensor = options.sensor().value();
+    const PipelineConfig from_file = options.resolve(sensor);
+    const PipelineConfig defaults = PipelineOptions{}.resolve(sensor);
+    for (const Parameter& parameter : pipeline_parameters()) {
+      EXPECT_EQ(parameter.value_in(from_file), parameter.value_in(defaults)) << file << ": " << parameter.flag;
+    }
+  }
+}
+
+TEST(Parameters, NumbersOutOfRangeOrOfTheWrongTypeAreRefused) {
+  for (const Parameter& parameter : pipeline_parameters()) {
+    if (parameter.type == Parameter::Type::Text) continue;
+    PipelineOptions above, text, fraction;
+    EXPECT_NE(parse({"--" + std::string(parameter.flag), std::to_string(parameter.max * 2 + 1)}, above), 0) << parameter.flag;
+    EXPECT_NE(parse({"--" + std::string(parameter.flag), "many"}, text), 0) << parameter.flag;
+    if (parameter.type == Parameter::Type::Integer) {
+      EXPECT_NE(parse({"--" + std::string(parameter.flag), "2.5"}, fraction), 0) << parameter.flag;
+    }
+  }
 }
 
 }  // namespace

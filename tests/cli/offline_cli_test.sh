@@ -8,11 +8,12 @@ src=$2
 sim=$tools/evldt-sim/evldt-sim
 offline=$tools/evldt-offline/evldt-offline
 eval=$tools/evldt-eval/evldt-eval
+config=$tools/evldt-config/evldt-config
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-for bin in "$sim" "$offline" "$eval"; do
+for bin in "$sim" "$offline" "$eval" "$config"; do
   "$bin" --help >"$work/help" || fail "$bin --help exit status"
   grep -q "Usage" "$work/help" || fail "$bin --help text"
   set +e
@@ -23,6 +24,18 @@ for bin in "$sim" "$offline" "$eval"; do
   grep -q "no-such-flag" "$work/out" || fail "$bin: unknown flag not named in the error"
 done
 echo "ok: --help and unknown flags"
+
+# evldt-config prints a configuration that --config takes back, the same for a size as its shipped file.
+"$config" --width 640 --height 480 >"$work/640.toml"
+"$config" --config "$work/640.toml" | cmp -s - "$work/640.toml" || fail "evldt-config's TOML does not read back to itself"
+"$config" --config "$src/config/640x480.toml" | cmp -s - "$work/640.toml" || fail "config/640x480.toml resolves otherwise than the defaults"
+"$config" --width 640 --height 480 --block-size 10 | grep -qx "block-size = 10" || fail "evldt-config ignores a flag"
+set +e
+"$config" >"$work/out" 2>&1
+status=$?
+set -e
+[[ $status -eq 1 ]] && grep -q "give the sensor size" "$work/out" || fail "evldt-config without a size: status $status"
+echo "ok: evldt-config's TOML reads back to itself and matches config/640x480.toml"
 
 "$sim" --scene boxes-6dof --duration-s 0.4 --format evt3 --format ecd --format evt2 --format dat --out-dir "$work/rec" -q >"$work/sim.txt"
 grep -q "events" "$work/sim.txt" || fail "simulator summary"

@@ -25,7 +25,7 @@ check "the package is evldt_${version}_${arch}.deb" test -s "$deb"
 # --- contents and dependencies ---------------------------------------------------------------------
 dpkg-deb -c "$deb" | awk '{ print $6 }' | sed 's|^\./|/|' >"$work/contents"
 for path in /usr/bin/evldt-camera /usr/bin/evldt-lines /usr/bin/evldt-viz /usr/bin/evldt-offline /usr/bin/evldt-eval \
-  /usr/bin/evldt-export /usr/bin/evldt-sim /etc/evldt/evldt.env /etc/evldt/camera-cam0.env /etc/evldt/640x480.toml \
+  /usr/bin/evldt-export /usr/bin/evldt-sim /usr/bin/evldt-config /etc/evldt/evldt.env /etc/evldt/camera-cam0.env /etc/evldt/640x480.toml \
   /etc/evldt/1280x720.toml /usr/lib/systemd/system/evldt-lines@.service /usr/lib/systemd/system/evldt-camera@.service \
   /usr/lib/systemd/system/evldt-viz@.service /usr/lib/systemd/system/evldt-logger.service; do
   check "the package holds $path" grep -qx "$path" "$work/contents"
