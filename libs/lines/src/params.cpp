@@ -11,7 +11,7 @@ PipelineConfig default_config_for(SensorSize sensor) {
     int block_size;
     float perturbation_px;
   };
-  // DESIGN section 5; dq scales with width from the closest row.
+  // docs/configuration.md; dq scales with width from the closest row.
   constexpr std::array<Row, 4> rows{{{240, 8, 0.8f}, {346, 10, 1.1f}, {640, 14, 2.5f}, {1280, 14, 2.5f}}};
   const Row* best = &rows[0];
   for (const Row& row : rows) {

@@ -1,5 +1,5 @@
 #pragma once
-// The noise filters (DESIGN 8: noise before storage):
+// The noise filters (docs/design.md, section 2):
 //   background-activity: the spatio-temporal correlation filter; an event passes when its pixel or
 //     one of its 8 neighbours fired within a time window (isolated thermal / leak events did not),
 //     while the sensor is noisy enough for that to pay;

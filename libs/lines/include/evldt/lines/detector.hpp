@@ -1,5 +1,5 @@
 #pragma once
-// Line detection (DESIGN 3): per free block, a robust line fit clipped to the block, kept when its
+// Line detection (docs/design.md, section 4): per free block, a robust line fit clipped to the block, kept when its
 // fitting score clears the threshold. A block whose entries have not changed since it last failed
 // is skipped: the fit and the score depend on nothing else, so it would fail again.
 

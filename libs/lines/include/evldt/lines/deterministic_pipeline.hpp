@@ -1,5 +1,5 @@
 #pragma once
-// The deterministic pipeline (DESIGN 6), its stages composed in this one place: the noise filters,
+// The deterministic pipeline (docs/design.md, section 7), its stages composed in this one place: the noise filters,
 // storage of every event that passes them in the lattice, tracking every track_period_us and
 // detection every detect_period_us of EVENT time, and at each output step, when asked for, the
 // whole lines; so a run's output depends only on its input.

@@ -1,5 +1,5 @@
 #pragma once
-// The fitting score f = r_o * r_e of a segment on a set of lattice entries (DESIGN 3.4).
+// The fitting score f = r_o * r_e of a segment on a set of lattice entries (docs/design.md, section 4).
 
 #include <cstdint>
 #include <span>

@@ -1,5 +1,5 @@
 #pragma once
-// Robust total-least-squares line fit (DESIGN 3.2): PCA, then a few rounds of Fair-weighted PCA,
+// Robust total-least-squares line fit (docs/design.md, section 4): PCA, then a few rounds of Fair-weighted PCA,
 // the same M-estimator OpenCV's fitLine(DIST_FAIR) uses, so outliers of a block pull the line less.
 
 #include <optional>

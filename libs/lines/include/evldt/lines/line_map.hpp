@@ -1,5 +1,5 @@
 #pragma once
-// The lines alive in the lattice and which block administers each (DESIGN 3.5 and 4.6): line ids,
+// The lines alive in the lattice and which block administers each (docs/design.md, sections 4 and 5): line ids,
 // block statuses, ownership transfer and detection suppression.
 
 #include <cstdint>

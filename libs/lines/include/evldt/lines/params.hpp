@@ -1,5 +1,5 @@
 #pragma once
-// Parameters of the line pipeline (DESIGN section 5), with defaults per sensor resolution.
+// Parameters of the line pipeline with defaults per sensor resolution (docs/configuration.md).
 
 #include <cstdint>
 
@@ -8,7 +8,7 @@
 
 namespace evldt {
 
-/// What the active-inlier count of a multi-block tracking score is divided by (DESIGN open question).
+/// What the active-inlier count of a multi-block tracking score is divided by (docs/design.md, section 9).
 enum class EffectiveRatioNorm : std::uint8_t {
   Block,  ///< N: long lines spanning k blocks can score r_e up to k
   Union,  ///< k * N: r_e stays in [0, 1] whatever the number of blocks
@@ -30,7 +30,7 @@ struct ScoreParams {
 };
 
 /// A new detection takes over the id of a line released nearby a moment before, so an id lasts
-/// through a short loss of its edge and through ownership hand-over (DESIGN 8: tracks that last).
+/// through a short loss of its edge and through ownership hand-over (docs/design.md, section 4).
 struct ReassociationParams {
   Timestamp window_us = 100'000;  ///< since the released line's last good track; 0: never
   float max_angle_deg = 10.0f;
@@ -116,7 +116,7 @@ struct PipelineConfig {
   int threads = 1;
 };
 
-/// DESIGN section 5 defaults for a sensor: b and dq from the nearest listed resolution, dq scaled by width.
+/// The defaults for a sensor (docs/configuration.md): b and dq from the nearest listed resolution, dq scaled by width.
 PipelineConfig default_config_for(SensorSize sensor);
 
 }  // namespace evldt

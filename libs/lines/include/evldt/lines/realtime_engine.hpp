@@ -1,5 +1,5 @@
 #pragma once
-// The real-time engine (DESIGN 6, 9): the caller's thread filters and stores events as they arrive
+// The real-time engine (docs/design.md, section 7): the caller's thread filters and stores events as they arrive
 // while detection and tracking loop on their own threads, each starting a round once a period of
 // event time has been stored since its last (or, when the input pauses, on whatever is new). So
 // the rounds follow the events: a stream replayed at a tenth of real time costs a tenth of the

@@ -1,5 +1,5 @@
 #pragma once
-// Line tracking (DESIGN 4): every live line tries its current segment and four endpoint
+// Line tracking (docs/design.md, section 5): every live line tries its current segment and four endpoint
 // perturbations along the lattice lines its endpoints sit on, keeps the best-scoring one, and the
 // manager then settles ownership and suppression.
 
@@ -27,7 +27,7 @@ struct EndpointMotion {
 EndpointMotion endpoint_motion(const Point2& endpoint, const Point2& segment_direction, const LatticeGeometry& geometry,
                                float perturbation_px);
 
-/// Distance from a line centre to a neighbouring block below which that block is suppressed (DESIGN 4.6).
+/// Distance from a line centre to a neighbouring block below which that block is suppressed (docs/design.md, section 5).
 inline constexpr float kSuppressRatio = 0.4f;
 
 class LineTracker {

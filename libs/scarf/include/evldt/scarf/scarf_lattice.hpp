@@ -1,5 +1,5 @@
 #pragma once
-// SCARF: "Set of Centre Active Receptive Fields" (DESIGN section 2).
+// SCARF: "Set of Centre Active Receptive Fields" (docs/design.md, section 3).
 //
 // The sensor is tiled by b x b blocks with a half-block margin. Each block keeps a fixed ring of the
 // N most recent events that fell into its active region (ACTIVE) or into the half-block band around

@@ -1,5 +1,5 @@
 #pragma once
-// The latency budget of a live subscriber (DESIGN 9, bounded latency): a batch that queued longer
+// The latency budget of a live subscriber (docs/design.md, section 7: under overload): a batch that queued longer
 // than the budget is thinned (every 2nd event kept, every 4th past 1.5 budgets), so that the events
 // kept still span all of its time and the whole sensor, and storage catches up; one that queued
 // twice the budget is shed whole (the last resort: a stretch of time without events). The lattice keeps only

@@ -1,5 +1,5 @@
 #pragma once
-// Loss accounting for a stream of numbered messages (DESIGN 7): a gap in the sequence is lost
+// Loss accounting for a stream of numbered messages (docs/design.md, section 8): a gap in the sequence is lost
 // messages; a newer publisher epoch (a restarted camera) starts the count afresh. A long run of
 // messages all behind the newest (epoch, sequence) means that newest was forged or stale: the
 // tracker then follows the stream that keeps arriving, so one bad message cannot silence a camera.
