@@ -218,7 +218,7 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   LineMap start = busy.lines();
   // Every line scored: the most work a pass can have (a pass reuses the score of a line settled on
   // blocks that have not changed since).
-  for (TrackedLine& line : start.lines()) line.settled_version = 0;
+  for (std::size_t i = 0; i < start.lines().size(); ++i) start.settled_version(i) = 0;
   f.lines_tracked = static_cast<double>(start.lines().size());
   LineMap tracked = start;
   const Timing copy = time_op(settings, [&] { tracked = start; });

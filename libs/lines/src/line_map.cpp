@@ -7,15 +7,6 @@
 
 namespace evldt {
 
-std::string_view status_name(LineStatus status) {
-  switch (status) {
-    case LineStatus::Detected: return "detected";
-    case LineStatus::GoodTrack: return "good";
-    case LineStatus::BadTrack: return "bad";
-  }
-  return "?";
-}
-
 std::string_view reason_name(ReleaseReason reason) {
   switch (reason) {
     case ReleaseReason::TooFewPoints: return "too-few-points";
@@ -35,6 +26,7 @@ LineMap::LineMap(const LatticeGeometry& geometry, const ReassociationParams& rea
       status_(static_cast<std::size_t>(geometry.block_count()), BlockStatus::NoDetect),
       owner_(static_cast<std::size_t>(geometry.block_count()), -1) {
   lines_.reserve(static_cast<std::size_t>(geometry.block_count()));  // at most one line per block
+  settled_.reserve(lines_.capacity());
 }
 
 void LineMap::set_block_status(int block, BlockStatus status) {
@@ -64,6 +56,7 @@ std::uint64_t LineMap::add(const Segment& segment, float score, int admin_block,
   status_[admin_block] = BlockStatus::Owned;
   owner_[admin_block] = static_cast<std::int32_t>(lines_.size());
   lines_.push_back(line);
+  settled_.push_back(0);
   return line.id;
 }
 
@@ -103,9 +96,11 @@ void LineMap::release(std::size_t index, ReleaseReason reason) {
   owner_[block] = -1;
   if (index + 1 != lines_.size()) {
     lines_[index] = lines_.back();
+    settled_[index] = settled_.back();
     owner_[lines_[index].admin_block] = static_cast<std::int32_t>(index);
   }
   lines_.pop_back();
+  settled_.pop_back();
   ++released_[static_cast<int>(reason)];
 }
 
@@ -175,6 +170,7 @@ void LineMap::clear() {
   std::fill(owner_.begin(), owner_.end(), -1);
   std::fill(released_by_block_.begin(), released_by_block_.end(), ReleasedLine{});
   lines_.clear();
+  settled_.clear();
 }
 
 }  // namespace evldt

@@ -92,7 +92,7 @@ std::uint64_t LineTracker::settled_passes() const {
 }
 
 void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp now) {
-  auto& all = lines.lines();
+  const std::span<TrackedLine> all = lines.lines();
   const bool settled_ok = lattice.versions_of() == versions_of_;
   versions_of_ = lattice.versions_of();
   // Every line's pass reads the lattice and writes only the line, so workers share the list freely.
@@ -106,7 +106,9 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
       if (begin >= n) return;
       for (std::size_t i = begin; i < std::min(n, begin + kLinesPerClaim); ++i) {
         ReleaseReason reason{};
-        outcome_[i] = track_line(lattice, all[i], now, settled_ok, worker, reason) ? kKept : static_cast<std::uint8_t>(reason);
+        outcome_[i] = track_line(lattice, all[i], lines.settled_version(i), now, settled_ok, worker, reason)
+                          ? kKept
+                          : static_cast<std::uint8_t>(reason);
       }
     }
   };
@@ -129,8 +131,8 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
   lines.manage(kSuppressRatio);
 }
 
-bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, bool settled_ok, Worker& worker,
-                             ReleaseReason& reason) const {
+bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, std::uint64_t& settled_version, Timestamp now,
+                             bool settled_ok, Worker& worker, ReleaseReason& reason) const {
   const float b = static_cast<float>(geometry_.block_size);
   if (line.segment.length() < 0.5f * b) {
     reason = ReleaseReason::TooShort;
@@ -145,11 +147,11 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Tim
   }
   std::uint64_t newest = 0;
   for (const int cell : cells) newest = std::max(newest, lattice.version(cell));
-  if (settled_ok && line.settled_version != 0 && line.settled_version == newest) {
+  if (settled_ok && settled_version != 0 && settled_version == newest) {
     ++worker.settled_passes;
     return judge(line, now, reason);
   }
-  line.settled_version = 0;
+  settled_version = 0;
   int active = 0;
   for (const int cell : cells) active += lattice.active_count(cell);
   if (active < geometry_.min_points()) {
@@ -190,7 +192,7 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, Tim
   }
   // The base hypothesis is the segment itself once its ends sit on lattice lines (every pass puts
   // them there); a pass that keeps it has settled the line.
-  if (best == 0 && hypotheses[0].q0 == line.segment.q0 && hypotheses[0].q1 == line.segment.q1) line.settled_version = newest;
+  if (best == 0 && hypotheses[0].q0 == line.segment.q0 && hypotheses[0].q1 == line.segment.q1) settled_version = newest;
   line.segment = hypotheses[best];
   line.score = best_score.score();
   return judge(line, now, reason);

@@ -8,7 +8,7 @@
 #include <span>
 #include <string>
 
-#include "evldt/lines/line_map.hpp"
+#include "evldt/lines/line_types.hpp"
 #include "evldt/stats_t.hpp"
 
 namespace evldt {

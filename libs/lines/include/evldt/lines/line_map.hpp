@@ -3,10 +3,12 @@
 // block statuses, ownership transfer and detection suppression.
 
 #include <cstdint>
+#include <span>
 #include <string_view>
 #include <vector>
 
 #include "evldt/lines/geometry.hpp"
+#include "evldt/lines/line_types.hpp"
 #include "evldt/lines/params.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"
 
@@ -16,23 +18,6 @@ enum class BlockStatus : std::uint8_t {
   NoDetect,           ///< free: detection may create a line here
   ProhibitDetection,  ///< skipped by the next detection round (a tracked line is too close)
   Owned,              ///< administers a line
-};
-
-enum class LineStatus : std::uint8_t { Detected, GoodTrack, BadTrack };
-std::string_view status_name(LineStatus status);
-
-struct TrackedLine {
-  std::uint64_t id = 0;
-  Segment segment;
-  float score = 0;
-  LineStatus status = LineStatus::Detected;
-  int admin_block = -1;
-  Timestamp first_seen_us = 0;
-  Timestamp last_good_us = 0;  ///< last time its score was above threshold (detection counts)
-  /// Tracker state: the newest version of the line's blocks at its last pass, if that pass left the
-  /// segment where it was; 0 otherwise. While its blocks keep that version a pass would repeat
-  /// itself exactly, so the tracker reuses its score.
-  std::uint64_t settled_version = 0;
 };
 
 /// Why a line ended; the pipeline's statistics count each.
@@ -64,7 +49,12 @@ class LineMap {
   explicit LineMap(const LatticeGeometry& geometry, const ReassociationParams& reassociation = {});
 
   [[nodiscard]] const std::vector<TrackedLine>& lines() const { return lines_; }
-  [[nodiscard]] std::vector<TrackedLine>& lines() { return lines_; }
+  /// The lines, to change in place (their number changes only through add and release).
+  [[nodiscard]] std::span<TrackedLine> lines() { return lines_; }
+  /// The tracker's bookkeeping for lines()[index]: the newest version of the line's blocks at its
+  /// last pass, if that pass left the segment where it was; 0 otherwise. While its blocks keep that
+  /// version a pass would repeat itself exactly, so the tracker reuses its score.
+  [[nodiscard]] std::uint64_t& settled_version(std::size_t index) { return settled_[index]; }
   [[nodiscard]] BlockStatus block_status(int block) const { return status_[block]; }
   void set_block_status(int block, BlockStatus status);
 
@@ -113,6 +103,7 @@ class LineMap {
   std::vector<BlockStatus> status_;
   std::vector<std::int32_t> owner_;  ///< per block: index into lines_ of the line it administers, or -1
   std::vector<TrackedLine> lines_;
+  std::vector<std::uint64_t> settled_;  ///< per line, settled_version()
   std::uint64_t first_id_ = 1;
   std::uint64_t next_id_ = 1;
   std::uint64_t released_[kReleaseReasonCount] = {};

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "evldt/events/csv_file.hpp"
-#include "evldt/lines/line_map.hpp"
+#include "evldt/lines/line_types.hpp"
 
 namespace evldt {
 

@@ -54,10 +54,10 @@ class LineTracker {
     PointSet points;         // the event set of the current line
     std::uint64_t settled_passes = 0;
   };
-  /// Tracks one line; false when it must be released (reason set). settled_ok: versions of this
-  /// lattice may be compared with those the lines were settled at.
-  bool track_line(const ScarfLattice& lattice, TrackedLine& line, Timestamp now, bool settled_ok, Worker& worker,
-                  ReleaseReason& reason) const;
+  /// Tracks one line; false when it must be released (reason set). settled_version: its
+  /// LineMap::settled_version; settled_ok: versions of this lattice may be compared with it.
+  bool track_line(const ScarfLattice& lattice, TrackedLine& line, std::uint64_t& settled_version, Timestamp now, bool settled_ok,
+                  Worker& worker, ReleaseReason& reason) const;
   /// Status after a pass that left line.score: good, or bad and released once out of patience.
   bool judge(TrackedLine& line, Timestamp now, ReleaseReason& reason) const;
 

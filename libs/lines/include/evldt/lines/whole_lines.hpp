@@ -17,14 +17,6 @@
 
 namespace evldt {
 
-struct WholeLine {
-  std::uint64_t id = 0;
-  Segment segment;              ///< the fitted line over the extent of its segments (and remembered ends)
-  std::uint32_t segments = 0;   ///< block segments joined into it at this step
-  Timestamp first_seen_us = 0;  ///< when its track began
-  Timestamp last_seen_us = 0;
-};
-
 class WholeLineTracker {
  public:
   /// block_size: the lattice's b, the unit of the distances in `params`. Ids start at first_id (a

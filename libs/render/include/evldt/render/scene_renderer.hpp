@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "evldt/lines/line_map.hpp"
+#include "evldt/lines/line_types.hpp"
 
 namespace evldt {
 

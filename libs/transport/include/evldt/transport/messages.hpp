@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "evldt/events/event.hpp"
-#include "evldt/lines/line_map.hpp"
+#include "evldt/lines/line_types.hpp"
 #include "evldt/event_batch_t.hpp"
 #include "evldt/segment_list_t.hpp"
 #include "evldt/stats_t.hpp"
