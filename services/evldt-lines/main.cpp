@@ -75,35 +75,7 @@ int main(int argc, char** argv) {
     announce_ready("evldt-lines", fmt::format("listening on {} ({}), publishing {} at {} Hz", events_channel(options.camera),
                                               lcm_options.effective_url(), lines_channel(options.camera), options.publish_hz));
     node.run(stop);
-    const LinesNodeTotals t = node.totals();
-    std::printf(
-        "evldt-lines summary\n"
-        "  batches   %llu received, %llu lost (sequence gaps), %llu late (%llu resyncs), %llu invalid messages, %llu camera restarts\n"
-        "  shed      %llu events, not stored: %llu batches shed whole, %llu thinned (latency budget %.0f ms)\n"
-        "  events    %llu received, %llu stored, %llu dropped as invalid (%llu off sensor, %llu back in time), %llu clock resets\n"
-        "  filters   dropped %llu hot-pixel, %llu background-activity, %llu refractory, %llu anti-flicker\n"
-        "  loops     %llu detection rounds (%llu while shedding, without the bend test), %llu tracking rounds\n"
-        "  output    %llu lines created, %llu segment lists published, %llu whole-line lists (%llu at %g Hz while shedding)\n"
-        "  latency   batch publish -> segment list: median %.1f ms, p99 %.1f ms (%u batches); settled, from 1 s after\n"
-        "            the first batch: median %.1f ms, p99 %.1f ms (%u batches)\n",
-        static_cast<unsigned long long>(t.receiver.sequence.received), static_cast<unsigned long long>(t.receiver.sequence.lost),
-        static_cast<unsigned long long>(t.receiver.sequence.late), static_cast<unsigned long long>(t.receiver.sequence.resyncs),
-        static_cast<unsigned long long>(t.receiver.invalid_messages),
-        static_cast<unsigned long long>(t.engine_restarts), static_cast<unsigned long long>(t.receiver.events_shed),
-        static_cast<unsigned long long>(t.receiver.batches_shed), static_cast<unsigned long long>(t.receiver.batches_thinned),
-        options.max_latency_ms,
-        static_cast<unsigned long long>(t.events_received),
-        static_cast<unsigned long long>(t.events_stored),
-        static_cast<unsigned long long>(t.receiver.drops.total()), static_cast<unsigned long long>(t.receiver.drops.off_sensor),
-        static_cast<unsigned long long>(t.receiver.drops.time_backwards),
-        static_cast<unsigned long long>(t.receiver.drops.clock_resets), static_cast<unsigned long long>(t.filtered.hot_pixel),
-        static_cast<unsigned long long>(t.filtered.background_activity), static_cast<unsigned long long>(t.filtered.refractory),
-        static_cast<unsigned long long>(t.filtered.anti_flicker), static_cast<unsigned long long>(t.detect_rounds),
-        static_cast<unsigned long long>(t.detect_rounds_without_bend_test),
-        static_cast<unsigned long long>(t.track_rounds), static_cast<unsigned long long>(t.lines_created),
-        static_cast<unsigned long long>(t.lists_published), static_cast<unsigned long long>(t.whole_lists_published),
-        static_cast<unsigned long long>(t.whole_lists_while_shedding), options.whole_lines_loaded_hz, t.latency.median_ms, t.latency.p99_ms, t.latency.samples,
-        t.settled_latency.median_ms, t.settled_latency.p99_ms, t.settled_latency.samples);
+    node.totals().print(stdout, options);
     return 0;
   });
 }

@@ -114,22 +114,8 @@ int main(int argc, char** argv) {
       }
       return true;
     });
-    const VizTotals t = node.totals();
-    std::printf("evldt-viz summary\n"
-                "  frames    %llu drawn, %d in the video, %d PNG snapshots\n"
-                "  received  %llu batches (%llu lost, %llu invalid), %llu segment lists (%llu invalid), %llu stats\n",
-                static_cast<unsigned long long>(t.frames), video_writer ? video_writer->frames() : 0,
-                png_writer ? png_writer->frames() : 0, static_cast<unsigned long long>(t.events.sequence.received),
-                static_cast<unsigned long long>(t.events.sequence.lost),
-                static_cast<unsigned long long>(t.events.invalid_messages),
-                static_cast<unsigned long long>(t.segment_lists), static_cast<unsigned long long>(t.invalid_segment_lists),
-                static_cast<unsigned long long>(t.stats));
-    if (web) {
-      const WebViewCounts w = web->counts();
-      std::printf("  web       %llu pages, %llu pictures sent (%llu encoded), %llu layer keys\n", static_cast<unsigned long long>(w.pages),
-                  static_cast<unsigned long long>(w.pictures), static_cast<unsigned long long>(w.encoded),
-                  static_cast<unsigned long long>(w.keys));
-    }
+    node.totals().print(stdout, video_writer ? video_writer->frames() : 0, png_writer ? png_writer->frames() : 0);
+    if (web) web->counts().print(stdout);
     return 0;
   });
 }

@@ -5,12 +5,35 @@
 #include <chrono>
 #include <cmath>
 #include <spdlog/spdlog.h>
+#include <fmt/core.h>
 #include <stdexcept>
 
 #include "evldt/lines/thread_name.hpp"
 #include "evldt/transport/channels.hpp"
 
 namespace evldt {
+
+void LinesNodeTotals::print(std::FILE* out, const LinesNodeOptions& options) const {
+  const SequenceCounts& sequence = receiver.sequence;
+  fmt::print(out, "evldt-lines summary\n");
+  fmt::print(out, "  batches   {} received, {} lost (sequence gaps), {} late ({} resyncs), {} invalid messages, {} camera restarts\n",
+             sequence.received, sequence.lost, sequence.late, sequence.resyncs, receiver.invalid_messages, engine_restarts);
+  fmt::print(out, "  shed      {} events, not stored: {} batches shed whole, {} thinned (latency budget {:.0f} ms)\n",
+             receiver.events_shed, receiver.batches_shed, receiver.batches_thinned, options.max_latency_ms);
+  fmt::print(out, "  events    {} received, {} stored, {} dropped as invalid ({} off sensor, {} back in time), {} clock resets\n",
+             events_received, events_stored, receiver.drops.total(), receiver.drops.off_sensor, receiver.drops.time_backwards,
+             receiver.drops.clock_resets);
+  fmt::print(out, "  filters   dropped {} hot-pixel, {} background-activity, {} refractory, {} anti-flicker\n", filtered.hot_pixel,
+             filtered.background_activity, filtered.refractory, filtered.anti_flicker);
+  fmt::print(out, "  loops     {} detection rounds ({} while shedding, without the bend test), {} tracking rounds\n", detect_rounds,
+             detect_rounds_without_bend_test, track_rounds);
+  fmt::print(out, "  output    {} lines created, {} segment lists published, {} whole-line lists ({} at {} Hz while shedding)\n",
+             lines_created, lists_published, whole_lists_published, whole_lists_while_shedding, options.whole_lines_loaded_hz);
+  fmt::print(out, "  latency   batch publish -> segment list: median {:.1f} ms, p99 {:.1f} ms ({} batches); settled, from 1 s after\n",
+             latency.median_ms, latency.p99_ms, latency.samples);
+  fmt::print(out, "            the first batch: median {:.1f} ms, p99 {:.1f} ms ({} batches)\n", settled_latency.median_ms,
+             settled_latency.p99_ms, settled_latency.samples);
+}
 namespace {
 // A statistics message lists at most this many masked pixels (16 KiB), whatever a broken sensor does.
 constexpr std::size_t kMaxListedMaskedPixels = 4096;

@@ -5,12 +5,20 @@
 #include <chrono>
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
+#include <fmt/core.h>
 #include <stdexcept>
 
 #include "evldt/render/status_text.hpp"
 #include "evldt/transport/channels.hpp"
 
 namespace evldt {
+
+void VizTotals::print(std::FILE* out, int video_frames, int png_frames) const {
+  fmt::print(out, "evldt-viz summary\n");
+  fmt::print(out, "  frames    {} drawn, {} in the video, {} PNG snapshots\n", frames, video_frames, png_frames);
+  fmt::print(out, "  received  {} batches ({} lost, {} invalid), {} segment lists ({} invalid), {} stats\n", events.sequence.received,
+             events.sequence.lost, events.invalid_messages, segment_lists, invalid_segment_lists, stats);
+}
 namespace {
 
 std::span<const std::uint8_t> payload_of(const lcm::ReceiveBuffer* buffer) {

@@ -1,5 +1,6 @@
 #include "evldt/web/web_view.hpp"
 
+#include <fmt/core.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -13,6 +14,10 @@
 #include "evldt/media/media.hpp"
 
 namespace evldt {
+
+void WebViewCounts::print(std::FILE* out) const {
+  fmt::print(out, "  web       {} pages, {} pictures sent ({} encoded), {} layer keys\n", pages, pictures, encoded, keys);
+}
 namespace {
 
 std::string escape_html(const std::string& text) {

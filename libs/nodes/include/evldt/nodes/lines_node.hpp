@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
@@ -68,6 +69,9 @@ struct LinesNodeTotals {
   std::uint64_t engine_restarts = 0;  ///< the camera restarted (new epoch): the lattice began afresh
   LatencySummary latency;             ///< batch publish -> first list including it, since the last camera (re)start
   LatencySummary settled_latency;     ///< the same, of the batches published 1 s or more after the first (LatencyTracker)
+
+  /// The exit summary, with the options it was run with.
+  void print(std::FILE* out, const LinesNodeOptions& options) const;
 };
 
 class LinesNode {

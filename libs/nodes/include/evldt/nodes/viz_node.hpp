@@ -4,6 +4,7 @@
 // renders frames at a set rate (surface, segments coloured by status, a status line).
 
 #include <atomic>
+#include <cstdio>
 #include <chrono>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
@@ -34,6 +35,9 @@ struct VizTotals {
   std::uint64_t whole_line_lists = 0;
   std::uint64_t stats = 0;
   std::uint64_t frames = 0;
+
+  /// The exit summary; the frames the service wrote to a video and as PNG snapshots are its own.
+  void print(std::FILE* out, int video_frames, int png_frames) const;
 };
 
 class VizNode {

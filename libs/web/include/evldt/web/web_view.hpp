@@ -13,6 +13,7 @@
 // number, status lines, layers), POST /key/K (a layer's key, as pressed in a window).
 
 #include <atomic>
+#include <cstdio>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -49,6 +50,9 @@ struct WebViewCounts {
   std::uint64_t pictures = 0;  ///< pictures sent (several browsers: each counts)
   std::uint64_t encoded = 0;   ///< pictures JPEG-encoded
   std::uint64_t keys = 0;      ///< layer keys pressed in browsers
+
+  /// The web line of the viz's exit summary.
+  void print(std::FILE* out) const;
 };
 
 class WebView {
