@@ -14,6 +14,17 @@ namespace {
 // hold one datagram's payload without growing (16 MiB in all, touched at start).
 constexpr std::size_t kQueuedBatches = 256;
 constexpr std::size_t kBatchSlotBytes = 64 * 1024;
+
+/// Adds the counts of an engine's life to `sum` (its times are not summed).
+void add_counts(EngineCounters& sum, const EngineCounters& engine) {
+  sum.events += engine.events;
+  sum.events_received += engine.events_received;
+  sum.filtered += engine.filtered;
+  sum.detect_rounds += engine.detect_rounds;
+  sum.detect_rounds_without_bend_test += engine.detect_rounds_without_bend_test;
+  sum.track_rounds += engine.track_rounds;
+  sum.lines_created += engine.lines_created;
+}
 }  // namespace
 
 LinesIngest::LinesIngest(const LinesNodeOptions& options, std::uint64_t first_line_id)
@@ -135,42 +146,29 @@ void LinesIngest::start_engine() {
   engine_started_.notify_all();
   if (engine_restarts_ > 0) latency_ = LatencyTracker();  // latency since the camera's (re)start
   next_line_id_ += retired.lines_created;
-  retired_.events += retired.events;
-  retired_.events_received += retired.events_received;
-  retired_.filtered += retired.filtered;
-  retired_.detect_rounds += retired.detect_rounds;
-  retired_.detect_rounds_without_bend_test += retired.detect_rounds_without_bend_test;
-  retired_.track_rounds += retired.track_rounds;
-  retired_.lines_created += retired.lines_created;
+  add_counts(retired_, retired);
 }
 
 void LinesIngest::add_to(LinesNodeTotals& totals) const {
   std::shared_ptr<RealtimeEngine> engine;
+  EngineCounters all;
   {
     std::lock_guard lock(mutex_);
     engine = engine_;
+    all = retired_;
     totals.receiver = receiver_counts_;
     totals.engine_restarts = engine_restarts_;
-    totals.events_stored = retired_.events;
-    totals.events_received = retired_.events_received;
-    totals.filtered = retired_.filtered;
-    totals.detect_rounds = retired_.detect_rounds;
-    totals.detect_rounds_without_bend_test = retired_.detect_rounds_without_bend_test;
-    totals.track_rounds = retired_.track_rounds;
-    totals.lines_created = retired_.lines_created;
     totals.latency = latency_.run_summary();
     totals.settled_latency = latency_.settled_summary();
   }
-  if (engine) {
-    const EngineCounters counters = engine->counters();
-    totals.events_stored += counters.events;
-    totals.events_received += counters.events_received;
-    totals.filtered += counters.filtered;
-    totals.detect_rounds += counters.detect_rounds;
-    totals.detect_rounds_without_bend_test += counters.detect_rounds_without_bend_test;
-    totals.track_rounds += counters.track_rounds;
-    totals.lines_created += counters.lines_created;
-  }
+  if (engine) add_counts(all, engine->counters());
+  totals.events_stored = all.events;
+  totals.events_received = all.events_received;
+  totals.filtered = all.filtered;
+  totals.detect_rounds = all.detect_rounds;
+  totals.detect_rounds_without_bend_test = all.detect_rounds_without_bend_test;
+  totals.track_rounds = all.track_rounds;
+  totals.lines_created = all.lines_created;
 }
 
 }  // namespace evldt
