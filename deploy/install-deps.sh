@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config
   liblcm-dev liblcm-bin liblcm-java libeigen3-dev libopencv-dev libspdlog-dev libcli11-dev
-  libgtest-dev libsystemd-dev libsqlite3-dev liblz4-dev libzstd-dev zlib1g-dev libflatbuffers-dev flatbuffers-compiler libcpp-httplib-dev librosbag-storage-dev libhdf5-dev hdf5-filter-plugin-blosc-serial libjchart2d-java default-jdk-headless
+  libgtest-dev libyaml-cpp-dev libsystemd-dev libsqlite3-dev liblz4-dev libzstd-dev zlib1g-dev libflatbuffers-dev flatbuffers-compiler libcpp-httplib-dev librosbag-storage-dev libhdf5-dev hdf5-filter-plugin-blosc-serial libjchart2d-java default-jdk-headless
   pybind11-dev python3-dev python3-numpy python3-pytest python3-pip python3-venv python3-setuptools python3-wheel "$@")
 missing=()
 for p in "${packages[@]}"; do

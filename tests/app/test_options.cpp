@@ -104,7 +104,11 @@ TEST(Parameters, EachSetsItsOwnFieldAndNoOther) {
     // others: the flicker band's lowest stays below its highest).
     const std::string old_value = parameter.value_in(defaults);
     std::vector<std::string> candidates;
-    if (parameter.type == Parameter::Type::Text) {
+    if (parameter.flag == "calibration") {  // a file: a pinhole camera of the sensor's size
+      const auto file = std::filesystem::temp_directory_path() / ("evldt_calib_" + std::to_string(::getpid()) + ".txt");
+      std::ofstream(file) << "500 500 320 240\n";
+      candidates.push_back(file.string());
+    } else if (parameter.type == Parameter::Type::Text) {
       candidates.push_back(parameter.choices.empty() ? "none" : std::string(parameter.choices.back()));
       if (!parameter.choices.empty()) candidates.push_back(std::string(parameter.choices.front()));
     } else {

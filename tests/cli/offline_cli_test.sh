@@ -234,4 +234,27 @@ if [[ -f $real ]]; then
 else
   echo "skip: no real recordings at $src/../shared/real (../shared is absent)"
 fi
+# Calibrated lines: boxes-6dof seen through the DAVIS240C's lens (--lens: events in sensor pixels)
+# scores far below the pinhole scene; with the calibration (any of its formats) as high as it.
+calib=$src/tests/data/calibration
+f_at_1() { awk '$1 == "boxes-6dof" && $2 != "whole" { print $5 }' "$1"; }
+"$eval" --scene boxes-6dof --duration-s 0.8 --log-level warn >"$work/pinhole.txt"
+"$eval" --scene boxes-6dof --duration-s 0.8 --lens "$calib/davis240c_calib.txt" --log-level warn >"$work/lens.txt"
+"$eval" --scene boxes-6dof --duration-s 0.8 --lens "$calib/davis240c_calib.txt" --calibration "$calib/davis240c_camchain.yaml" \
+  --log-level warn >"$work/calibrated.txt"
+pinhole=$(f_at_1 "$work/pinhole.txt") lens=$(f_at_1 "$work/lens.txt") calibrated=$(f_at_1 "$work/calibrated.txt")
+awk -v p="$pinhole" -v l="$lens" -v c="$calibrated" 'BEGIN { exit !(p > 0.8 && l < p - 0.1 && c > p - 0.02) }' ||
+  fail "F@1% pinhole $pinhole, through the lens $lens, calibrated $calibrated"
+"$offline" --scene boxes-6dof --duration-s 0.3 --lens "$calib/davis240c_calib.txt" --calibration "$calib/davis240c_opencv.xml" \
+  -o "$work/calibrated.csv" >"$work/calibrated_summary.txt"
+grep -Eq "calibration +.*davis240c_opencv.xml: [1-9][0-9]* events left out" "$work/calibrated_summary.txt" ||
+  fail "the summary says what the calibration left out: $(cat "$work/calibrated_summary.txt")"
+set +e
+"$offline" --scene boxes-6dof --duration-s 0.1 --calibration "$calib/hd_equidistant_camchain.yaml" -o "$work/x.csv" >"$work/out" 2>&1
+status=$?
+set -e
+[[ $status -eq 1 ]] && grep -q "calibration is of a 1280x720 camera, the sensor 240x180" "$work/out" ||
+  fail "a calibration of another size: status $status, $(cat "$work/out")"
+echo "ok: calibrated lines: F@1% $pinhole pinhole, $lens through the lens, $calibrated with the calibration"
+
 echo "offline CLI: every check passed"

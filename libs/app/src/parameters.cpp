@@ -97,6 +97,12 @@ const std::vector<Parameter>& table() {
        .help = "Threads each tracking and detection round is split over; the output is the same for any count",
        .field = +[](PipelineConfig& c) -> int& { return c.threads; },
        .default_text = "the cores less one for the receiving thread, at least 1"},
+      {.flag = "calibration", .group = kPipeline, .type = Type::Text,
+       .help = "Camera calibration file (ROS camera_info or Kalibr camchain YAML, OpenCV FileStorage YAML/XML, the "
+               "ECD's calib.txt): after the noise filters, events move into the rectified image, where the lattice and "
+               "the lines live; none: the sensor's pixels as they are",
+       .field = Parameter::TextField{[](const PipelineConfig& c) { return c.calibration; },
+                                     [](PipelineConfig& c, const std::string& text) { c.calibration = text.empty() ? "none" : text; }}},
       {.flag = "filters", .group = kFilters, .type = Type::Text,
        .help = "Filters in order, comma-separated: hot-pixel, background-activity, refractory, anti-flicker; or none",
        .field = Parameter::TextField{[](const PipelineConfig& c) { return format_filter_chain(c.filters.chain); },

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "evldt/app/parameters.hpp"
+#include "evldt/calibration/camera_model.hpp"
 #include "evldt/lines/worker_pool.hpp"
 
 namespace evldt {
@@ -106,6 +107,7 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
     if (values_[i]) parameters[i].set(config, *values_[i]);
   }
   check_filter_config(config.filters);
+  if (config.calibration != "none") config.rectification = rectification_table(read_camera_model(config.calibration), sensor);
   return config;
 }
 

@@ -10,6 +10,7 @@ namespace evldt {
 
 void RunSummary::add_pipeline(const DeterministicPipeline& pipeline) {
   filters = format_filter_chain(pipeline.config().filters.chain);
+  calibration = pipeline.config().calibration;
   filtered = pipeline.filter_counts();
   counters = pipeline.counters();
   const LineMap& lines = pipeline.lines();
@@ -35,6 +36,10 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
                  " background-activity, %" PRIu64 " refractory, %" PRIu64 " anti-flicker\n",
                  filters.c_str(), filtered.events_in, filtered.passed, filtered.hot_pixel, filtered.background_activity,
                  filtered.refractory, filtered.anti_flicker);
+  }
+  if (calibration != "none") {
+    std::fprintf(out, "  calibration      %s: %" PRIu64 " events left out, their pixel off the rectified image\n", calibration.c_str(),
+                 counters.off_rectified);
   }
   if (decoded.skipped_words > 0 || decoded.trigger_events > 0) {
     std::fprintf(out, "  decoding         %" PRIu64 " words of reserved or unknown types skipped, %" PRIu64 " trigger events\n",
@@ -80,6 +85,7 @@ void RunSummary::write_json(const std::filesystem::path& path) const {
   out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds << ",\n";
   out << "  \"skipped_rounds\": " << counters.skipped_rounds << ",\n";
   out << "  \"clock_restarts\": " << counters.clock_restarts << ",\n";
+  out << "  \"events_off_rectified\": " << counters.off_rectified << ",\n";
   out << "  \"lines_created\": " << lines_created << ",\n  \"lines_reassociated\": " << lines_reassociated
       << ",\n  \"lines_alive\": " << lines_alive << ",\n  \"released\": {";
   for (int r = 0; r < kReleaseReasonCount; ++r) {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "evldt/app/pipeline_options.hpp"
+#include "evldt/calibration/camera_model.hpp"
 #include "evldt/sim/scenes.hpp"
 
 namespace evldt {
@@ -35,6 +36,10 @@ void SimulatorOptions::add_to(CLI::App& app, bool scene_required) {
       ->check(finite_number() & CLI::Range(0.0, 1e10));
   group->add_option("--jitter-us", jitter_us_, "Timestamps up to this much later (default 0, the scene's own)")
       ->check(CLI::Range(Timestamp{0}, Timestamp{100'000}));
+  group->add_option("--lens", lens_,
+                    "The scene through this calibrated lens (a file --calibration reads): events in sensor pixels, the "
+                    "scene's exact lines rectified")
+      ->check(CLI::ExistingFile);
 }
 
 SimulatorConfig SimulatorOptions::config() const {
@@ -48,6 +53,16 @@ SimulatorConfig SimulatorOptions::config() const {
   if (hot_pixels_) config.hot_pixels = *hot_pixels_;
   if (readout_rate_eps_) config.readout_rate_eps = *readout_rate_eps_;
   if (jitter_us_) config.timestamp_jitter_us = *jitter_us_;
+  if (lens_ && !scene_.empty()) {
+    const CameraModel model = read_camera_model(*lens_);
+    const SensorSize sensor = make_scene(scene_).sensor;
+    if (model.size.width > 0 && !(model.size == sensor)) {
+      throw std::invalid_argument("--lens: the calibration is of a " + std::to_string(model.size.width) + "x" +
+                                  std::to_string(model.size.height) + " camera, the scene's sensor " + std::to_string(sensor.width) +
+                                  "x" + std::to_string(sensor.height));
+    }
+    config.lens = std::make_shared<const std::vector<float>>(undistorted_pixel_centres(model, sensor));
+  }
   return config;
 }
 

@@ -17,6 +17,7 @@ DeterministicPipeline::DeterministicPipeline(const PipelineConfig& config, bool 
   if (config.schedule.track_period_us <= 0 || config.schedule.detect_period_us <= 0) {
     throw std::invalid_argument("tracking and detection periods must be positive");
   }
+  if (config_.rectification) rectifier_.emplace(*config_.rectification);
 }
 
 void DeterministicPipeline::set_output(Timestamp period_us, StepCallback on_step, bool whole_lines) {
@@ -78,7 +79,13 @@ void DeterministicPipeline::process_filtered(const EventBatch& batch, const Even
     ++counters_.clock_restarts;
     start(batch.t[0]);
   }
-  store(filtered);
+  if (rectifier_) {
+    rectifier_->apply(filtered, rectified_);
+    counters_.off_rectified = rectifier_->dropped();
+    store(rectified_);
+  } else {
+    store(filtered);
+  }
   // Rounds due up to the batch's last event: every stored event is older than them (store() ran
   // each round due at or before a stored event's time before storing it).
   if (batch.t.back() >= next_due_) run_rounds_until(batch.t.back());

@@ -27,6 +27,10 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
       detector_(lattice_.geometry(), config.score, &pool_),
       tracker_(lattice_.geometry(), config.score, config.track, &pool_) {
   filtered_.reserve_touched(kPreparedBatch);
+  if (config_.rectification) {
+    rectifier_.emplace(*config_.rectification);
+    rectified_.reserve_touched(kPreparedBatch);
+  }
   if (config.schedule.shedding_period_factor < 1) throw std::invalid_argument("shedding_period_factor must be at least 1");
   if (config.schedule.input_pause_ms < 1) throw std::invalid_argument("input_pause_ms must be at least 1");
 }
@@ -68,10 +72,16 @@ void RealtimeEngine::process(const EventBatch& input) {
   if (input.empty()) return;
   storing_.store(true, std::memory_order_relaxed);
   const EventBatch* stored = &input;
-  if (!filters_.empty()) {
+  {
     std::lock_guard lock(filter_mutex_);
-    filters_.filter(input, filtered_);
-    stored = &filtered_;
+    if (!filters_.empty()) {
+      filters_.filter(input, filtered_);
+      stored = &filtered_;
+    }
+    if (rectifier_) {  // onto the rectified image, after the filters (which work on sensor pixels)
+      rectifier_->apply(*stored, rectified_);
+      stored = &rectified_;
+    }
   }
   const EventBatch& batch = *stored;
   const std::size_t n = batch.size();
@@ -229,6 +239,7 @@ EngineCounters RealtimeEngine::counters() const {
   {
     std::lock_guard lock(filter_mutex_);
     c.filtered = filters_.counts();
+    c.off_rectified = rectifier_ ? rectifier_->dropped() : 0;
   }
   {
     std::lock_guard lock(lattice_mutex_);

@@ -48,6 +48,9 @@ void fill_convex(const std::vector<Vec2d>& polygon, float value, int width, int 
 EventSimulator::EventSimulator(Scene scene, const SimulatorConfig& config)
     : scene_(std::move(scene)), config_(config), random_(config.seed), width_(scene_.sensor.width), height_(scene_.sensor.height) {
   if (!scene_.sensor.valid()) throw std::invalid_argument("scene has no sensor size");
+  if (config.lens && config.lens->size() != 2 * static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_)) {
+    throw std::invalid_argument("the lens does not match the scene's sensor size");
+  }
   if (!(config.contrast_on > 0) || !(config.contrast_off > 0) || !(config.max_step_px > 0) || config.max_step_us <= 0) {
     throw std::invalid_argument("contrast thresholds and step limits must be positive");
   }
@@ -72,10 +75,32 @@ EventSimulator::EventSimulator(Scene scene, const SimulatorConfig& config)
 
 void EventSimulator::render(Timestamp t_us, std::vector<float>& log_image) const {
   const double t = static_cast<double>(t_us) * 1e-6;
-  std::fill(log_image.begin(), log_image.end(), log_intensity(scene_.background));
+  std::vector<float>& canvas = config_.lens ? lens_canvas_ : log_image;
+  canvas.resize(log_image.size());
+  const float background = log_intensity(scene_.background);
+  std::fill(canvas.begin(), canvas.end(), background);
   for (std::size_t k = 0; k < scene_.shapes.size(); ++k) {
     const Shape& shape = scene_.shapes[k];
-    fill_convex(scene_.polygon_at(k, t), log_intensity(shape.brightness * shape.flicker.factor_at(t_us)), width_, height_, log_image);
+    fill_convex(scene_.polygon_at(k, t), log_intensity(shape.brightness * shape.flicker.factor_at(t_us)), width_, height_, canvas);
+  }
+  if (!config_.lens) return;
+  // Each sensor pixel sees the rectified scene where its centre looks: bilinear between the four
+  // rendered pixels around that point (centres at index + 0.5), the background beyond the image.
+  const std::vector<float>& looks = *config_.lens;
+  for (std::size_t i = 0; i < log_image.size(); ++i) {
+    const float u = looks[2 * i] - 0.5f, v = looks[2 * i + 1] - 0.5f;
+    if (!(u >= -0.5f && v >= -0.5f && u <= static_cast<float>(width_) - 0.5f && v <= static_cast<float>(height_) - 0.5f)) {
+      log_image[i] = background;
+      continue;
+    }
+    const int x0 = std::clamp(static_cast<int>(std::floor(u)), 0, width_ - 2), y0 = std::clamp(static_cast<int>(std::floor(v)), 0, height_ - 2);
+    const float ax = std::clamp(u - static_cast<float>(x0), 0.0f, 1.0f), ay = std::clamp(v - static_cast<float>(y0), 0.0f, 1.0f);
+    const float* row = canvas.data() + static_cast<std::size_t>(y0) * static_cast<std::size_t>(width_) + x0;
+    // Weighted sums, so that a look at a pixel's centre takes its value exactly (a pinhole lens
+    // gives the pinhole's events).
+    const float top = (1.0f - ax) * row[0] + ax * row[1];
+    const float bottom = (1.0f - ax) * row[width_] + ax * row[width_ + 1];
+    log_image[i] = (1.0f - ay) * top + ay * bottom;
   }
 }
 

@@ -19,6 +19,7 @@ struct RunSummary {
   DropCounts drops;
   std::string filters;     ///< the chain, "none" for no filter
   FilterCounts filtered;
+  std::string calibration = "none";  ///< the calibration file, "none" for none
   double event_seconds = 0;
   double wall_seconds = 0;
   PipelineCounters counters;

@@ -30,6 +30,7 @@ class SimulatorOptions {
   std::optional<double> contrast_, contrast_sigma_, noise_rate_hz_, dark_noise_hz_, readout_rate_eps_;
   std::optional<Timestamp> refractory_us_, jitter_us_;
   std::optional<int> hot_pixels_;
+  std::optional<std::string> lens_;
 };
 
 }  // namespace evldt

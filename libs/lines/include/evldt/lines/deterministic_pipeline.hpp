@@ -21,6 +21,7 @@ struct PipelineCounters {
   std::uint64_t detect_rounds = 0;
   std::uint64_t skipped_rounds = 0;  ///< rounds not run across long gaps in event time
   std::uint64_t clock_restarts = 0;  ///< schedules begun again because event time went back
+  std::uint64_t off_rectified = 0;   ///< events whose pixel lies off the rectified image (with a calibration)
 };
 
 /// A batch starting this far before the next due round means the clock went back (an EventValidator
@@ -78,6 +79,8 @@ class DeterministicPipeline {
   PipelineConfig config_;
   FilterChain filters_;
   EventBatch filtered_;  // what passed the filters, reused
+  std::optional<Rectifier> rectifier_;  // with a calibration
+  EventBatch rectified_;                // what passed the filters, in the rectified image, reused
   ScarfLattice lattice_;
   LineMap lines_;
   WorkerPool pool_;  // config.threads; shared by the detector and the tracker

@@ -2,9 +2,12 @@
 // Parameters of the line pipeline with defaults per sensor resolution (docs/configuration.md).
 
 #include <cstdint>
+#include <memory>
+#include <string>
 
 #include "evldt/events/event.hpp"
 #include "evldt/filters/filter_chain.hpp"
+#include "evldt/lines/rectifier.hpp"
 
 namespace evldt {
 
@@ -111,6 +114,11 @@ struct PipelineConfig {
   TrackParams track;
   ScheduleParams schedule;
   WholeLineParams whole_lines;
+  /// A camera calibration file ("none": the sensor's pixels are taken as they are) and the table made
+  /// of it for the sensor (PipelineOptions::resolve): events move into the rectified image after the
+  /// noise filters, and the lattice and the lines live there.
+  std::string calibration = "none";
+  std::shared_ptr<const RectificationTable> rectification;
   /// Threads a tracking or detection round is split over (a worker pool): the output is the same
   /// for any count.
   int threads = 1;

@@ -17,6 +17,7 @@
 #include <condition_variable>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -29,6 +30,7 @@ struct EngineCounters {
   FilterCounts filtered;             ///< what the noise filters let through and dropped
   std::uint64_t events_received = 0;  ///< handed to process()
   std::uint64_t events = 0;           ///< stored
+  std::uint64_t off_rectified = 0;    ///< left out: their pixel lies off the rectified image (with a calibration)
   std::uint64_t detect_rounds = 0;
   std::uint64_t detect_rounds_without_bend_test = 0;  ///< those run while shedding
   std::uint64_t track_rounds = 0;
@@ -103,6 +105,8 @@ class RealtimeEngine {
   mutable std::mutex filter_mutex_;           // the producer filters under it; counters() reads under it
   FilterChain filters_;                       // guarded by filter_mutex_
   EventBatch filtered_;                       // the producer's, reused
+  std::optional<Rectifier> rectifier_;        // with a calibration; guarded by filter_mutex_
+  EventBatch rectified_;                      // the producer's, reused
   ScarfLattice lattice_;                      // guarded by lattice_mutex_
   mutable std::mutex lattice_mutex_;
   std::condition_variable lattice_changed_;

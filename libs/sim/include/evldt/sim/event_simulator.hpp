@@ -8,6 +8,7 @@
 // Deterministic for a seed.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "evldt/events/event.hpp"
@@ -33,6 +34,10 @@ struct SimulatorConfig {
   Timestamp readout_queue_us = 1000;
   Timestamp timestamp_jitter_us = 0;  ///< up to this much later, uniformly (kept in time order)
   std::uint64_t seed = 1;
+  /// The scene through a calibrated lens: per sensor pixel (row-major), where its centre looks in the
+  /// scene's (rectified) coordinates, x then y (undistorted_pixel_centres of libs/calibration). The
+  /// events then come in sensor pixels while the scene's exact lines stay rectified. Null: a pinhole.
+  std::shared_ptr<const std::vector<float>> lens;
 };
 
 struct SimulatorCounters {
@@ -85,6 +90,7 @@ class EventSimulator {
   Timestamp now_ = 0;        // events up to here have been handed out
   Timestamp rendered_ = 0;   // time of the newest rendered sub-frame
   std::vector<float> log_prev_, log_now_, log_reference_;
+  mutable std::vector<float> lens_canvas_;  // with a lens: the scene rendered rectified, then sampled per pixel
   std::vector<float> threshold_on_, threshold_off_;
   std::vector<Timestamp> last_event_;
   std::vector<std::uint32_t> hot_pixels_;
