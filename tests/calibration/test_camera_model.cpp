@@ -133,7 +133,7 @@ TEST(CameraModel, ABadFileSaysWhichAndWhy) {
 }
 
 TEST(Rectifier, MovesEventsToTheirRectifiedPixelsAndCountsThoseOff) {
-  RectificationTable table{{4, 2}, std::vector<std::uint32_t>(8, RectificationTable::kOff)};
+  RectificationTable table{{4, 2}, {}, std::vector<std::uint32_t>(8, RectificationTable::kOff)};
   table.target[1] = 2u | 1u << 16;  // (1, 0) -> (2, 1)
   table.target[6] = 0u;             // (2, 1) -> (0, 0)
   Rectifier rectifier(table);

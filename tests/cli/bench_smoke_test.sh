@@ -8,7 +8,7 @@ trap 'rm -rf "$work"' EXIT
 "$1" --sizes 240x180 --repeats 1 --min-time-ms 1 --window-ms 50 --json "$work/bench.json" >"$work/out.txt"
 cat "$work/out.txt"
 grep -q '^240x180 *boxes-6dof' "$work/out.txt"
-for key in storage_mev_s receive_mev_s detect_hz track_hz filters_mev_s pipeline_mev_s lattice_mb peak_rss_mb active_points lines_tracked; do
+for key in storage_mev_s receive_mev_s detect_hz track_hz filters_mev_s rectify_mev_s pipeline_mev_s lattice_mb peak_rss_mb active_points lines_tracked; do
   value=$(grep -oP "\"$key\": \K[0-9.e+-]+" "$work/bench.json")
   awk -v v="$value" 'BEGIN { exit !(v > 0) }' || { echo "FAILED: $key = '$value'"; exit 1; }
 done

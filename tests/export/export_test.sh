@@ -28,7 +28,9 @@ cp "$source_dir/tests/export/validate_foxglove.mjs" "$checker/"
 # --- a live run, recorded ---------------------------------------------------------------------
 "${logger[@]}" --lcm-url="$url&$logger_buffer" -f -q "$work/run.lcmlog" &
 logger_pid=$!
-"$lines" --lcm-url "$url" --log-period-s 0.2 >"$work/lines.out" 2>"$work/lines.err" &
+# With a calibration (one that keeps every pixel), so that the camera goes into the file too.
+"$lines" --lcm-url "$url" --log-period-s 0.2 --calibration "$source_dir/tests/data/calibration/pinhole_240x180.yaml" \
+  >"$work/lines.out" 2>"$work/lines.err" &
 lines_pid=$!
 wait_logger_ready "$url" "$work/run.lcmlog" TEST_MARKER
 wait_ready "$work/lines.err" evldt-lines
@@ -39,6 +41,7 @@ check "camera exits 0" test $? -eq 0
 batches=$(field "$work/camera.out" 'batches')
 log_holds_all "$url" "$work/run.lcmlog" EVENTS_CAM0 "$((batches + 3))"
 wait_until "whole lines in the log" log_holds "$url" "$work/run.lcmlog" WHOLE_LINES_CAM0 5
+wait_until "the camera in the log" log_holds "$url" "$work/run.lcmlog" CAMERA_INFO_CAM0 1
 stops_promptly "$lines_pid" >/dev/null
 wait_until "a statistics message in the log" log_holds "$url" "$work/run.lcmlog" EVLDT_STATS 1
 stops_promptly "$logger_pid" INT >/dev/null
@@ -48,10 +51,11 @@ stops_promptly "$logger_pid" INT >/dev/null
 check "evldt-export exits 0" test $? -eq 0
 cat "$work/export.out"
 pictures=$(field "$work/export.out" 'written')
-check "segment lists and whole-line lists written" grep -qP 'pictures, [1-9][0-9]* segment lists, [1-9][0-9]* whole-line lists, [1-9][0-9]* statistics' "$work/export.out"
+check "segment lists, whole-line lists and the camera written" \
+  grep -qP 'pictures, [1-9][0-9]* segment lists, [1-9][0-9]* whole-line lists, [1-9][0-9]* statistics, [1-9][0-9]* camera calibrations' "$work/export.out"
 check "the undecodable messages counted (3 batches, 2 lists)" grep -q "skipped   5 undecodable" "$work/export.out"
 check "the undecodable messages reported" grep -q "5 undecodable messages of camera cam0 skipped" "$work/export.err"
-for topic in events segments whole_lines stats; do
+for topic in events segments whole_lines stats camera_info; do
   "$dump" "$work/run.mcap" "/cam0/$topic" >"$work/$topic.dump" 2>"$work/$topic.err"
   check "evldt's MCAP reader reads /cam0/$topic back" test $? -eq 0
 done
@@ -64,8 +68,10 @@ check "pictures at 20 Hz: ${pictures:-none} of at most ${most:-?}, none early" \
   awk -v n="${pictures:-0}" -v most="${most:-0}" -v early="${early:-1}" 'BEGIN { exit !(n >= 15 && n <= most && early == 0) }'
 check "the pictures' channel is foxglove.CompressedImage in JSON" grep -q "^foxglove.CompressedImage jsonschema json $pictures\$" "$work/events.dump"
 check "the segments' channel is foxglove.ImageAnnotations" grep -q "^foxglove.ImageAnnotations jsonschema json " "$work/segments.dump"
+check "the camera is foxglove.CameraCalibration with the calibration's K" \
+  grep -qP '"K": \[199.1, 0, 119.5, 0, 198.8, 89.5, 0, 0, 1\]' "$work/camera_info.dump"
 check "whole lines carry their ids as texts" grep -qP '"texts": \[\{"timestamp": \{"sec": [0-9]+, "nsec": [0-9]+\}, "position"' "$work/whole_lines.dump"
-(cd "$checker" && node validate_foxglove.mjs "$work"/{events,segments,whole_lines,stats}.dump) >"$work/validate.out" 2>&1
+(cd "$checker" && node validate_foxglove.mjs "$work"/{events,segments,whole_lines,stats,camera_info}.dump) >"$work/validate.out" 2>&1
 check "every message valid against Foxglove's published schemas and the file's own" test $? -eq 0
 cat "$work/validate.out"
 "$dump" "$work/run.mcap" /cam0/nothing >/dev/null 2>"$work/nothing.err"

@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 #include <thread>
 
+#include "evldt/camera_info_t.hpp"
 #include "evldt/events/event_writer.hpp"
 #include "evldt/nodes/camera_node.hpp"
 #include "evldt/nodes/lines_node.hpp"
@@ -366,6 +367,62 @@ TEST(Nodes, ConfiguredSensorEngineServesTheFirstBatch) {
     segments += list.segments.size();
   }
   EXPECT_GT(segments, 0u);
+}
+
+// Records every CAMERA_INFO message of a camera.
+class CameraInfoCollector {
+ public:
+  explicit CameraInfoCollector(lcm::LCM& lcm) { lcm.subscribe("CAMERA_INFO_CAM0", &CameraInfoCollector::on_info, this); }
+  void on_info(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    camera_info_t msg;
+    const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size);
+    std::lock_guard lock(mutex_);
+    if (decode_message(bytes, msg) == WireError::None) infos_.push_back(msg);
+  }
+  std::vector<camera_info_t> infos() const {
+    std::lock_guard lock(mutex_);
+    return infos_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<camera_info_t> infos_;
+};
+
+TEST(Nodes, WithACalibrationTheLinesComeWithTheirCamera) {
+  lcm::LCM lcm("memq://");
+  ListCollector collector(lcm, "LINES_CAM0");
+  CameraInfoCollector cameras(lcm);
+  LinesNodeOptions options = quiet_lines();
+  // A calibration whose table keeps every pixel (libs/calibration makes real ones; tested there).
+  options.configure = [](SensorSize sensor) {
+    PipelineConfig config = default_config_for(sensor);
+    auto table = std::make_shared<RectificationTable>();
+    table->sensor = sensor;
+    table->lens = {199.1, 198.8, 132.2, 110.7, "radtan", {-0.37, 0.15, -0.0003, -0.0008}, "davis240c.yaml"};
+    for (int y = 0; y < sensor.height; ++y) {
+      for (int x = 0; x < sensor.width; ++x) table->target.push_back(static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16);
+    }
+    config.calibration = "davis240c.yaml";
+    config.rectification = table;
+    return config;
+  };
+  RunningLines lines(lcm, 4'000'000, options);
+  const std::atomic<bool> never{false};
+  const CameraSummary sent = CameraNode(lcm, fast_camera(), 1).run(scene_source("boxes-6dof", 200'000), never);
+  ASSERT_TRUE(wait_for([&] { return cameras.infos().size() >= 2 && !collector.lists().empty(); }));
+  lines.stop();
+  const camera_info_t info = cameras.infos().back();
+  EXPECT_EQ(info.source, "cam0");
+  EXPECT_EQ(info.epoch, 4'000'000);
+  EXPECT_EQ(info.width, 240);
+  EXPECT_EQ(info.height, 180);
+  EXPECT_DOUBLE_EQ(info.fx, 199.1);
+  EXPECT_DOUBLE_EQ(info.cy, 110.7);
+  EXPECT_EQ(info.sensor_distortion, "radtan");
+  EXPECT_EQ(info.calibration, "davis240c.yaml");
+  EXPECT_EQ(info.coefficients, (std::vector<double>{-0.37, 0.15, -0.0003, -0.0008}));
+  EXPECT_EQ(lines.node.totals().events_received, sent.events_published);
 }
 
 TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {

@@ -15,7 +15,9 @@ scene=(--scene boxes-6dof --duration-s 1.5)
 # --- live run ---------------------------------------------------------------------------------
 "${logger[@]}" --lcm-url="$url&$logger_buffer" -f -q "$work/live.lcm" &
 logger_pid=$!
-"$lines" --lcm-url "$url" --log-period-s 0 >"$work/lines.out" 2>"$work/lines.err" &
+# With a calibration that keeps every pixel: the same lines, and the camera on CAMERA_INFO_CAM0.
+"$lines" --lcm-url "$url" --log-period-s 0 --calibration "$source_dir/tests/data/calibration/pinhole_240x180.yaml" \
+  >"$work/lines.out" 2>"$work/lines.err" &
 lines_pid=$!
 "$viz" --lcm-url "$url" --headless --video "$work/viz.mp4" --png-dir "$work/png" --png-period-s 0.5 --fps 20 \
   >"$work/viz.out" 2>"$work/viz.err" &
@@ -136,6 +138,7 @@ if [[ -f $jar ]] && command -v javac >/dev/null; then
     grep -q "EVENTS_CAM0 evldt.event_batch_t" "$work/spy.out"
   check "... segment lists" grep -q "LINES_CAM0 evldt.segment_list_t" "$work/spy.out"
   check "... statistics" grep -q "EVLDT_STATS evldt.stats_t" "$work/spy.out"
+  check "... the calibrated camera" grep -q "CAMERA_INFO_CAM0 evldt.camera_info_t" "$work/spy.out"
   check "... and the junk does not decode" grep -qP "EVENTS_CAM0 (undecodable|no-type) [1-8]$" "$work/spy.out"
 else
   echo "skipped: lcm-spy decoding (no javac or no jar)"

@@ -201,6 +201,33 @@ TEST(Messages, EveryTruncationIsMalformed) {
   expect_every_prefix_malformed<stats_t>(encode(make_stats()));
 }
 
+camera_info_t make_camera_info() {
+  RectificationTable table;
+  table.sensor = {240, 180};
+  table.lens = {199.1, 198.8, 132.2, 110.7, "radtan", {-0.37, 0.15, -0.0003, -0.0008, 0.0}, "calib.yaml"};
+  camera_info_t msg{};
+  msg.utime = 5;
+  msg.epoch = 6;
+  msg.source = "cam0";
+  fill_camera_info(table, msg);
+  return msg;
+}
+
+TEST(Messages, CameraInfoRoundTrip) {
+  camera_info_t decoded;
+  ASSERT_EQ(decode_message(encode(make_camera_info()), decoded), WireError::None);
+  EXPECT_EQ(decoded.width, 240);
+  EXPECT_EQ(decoded.height, 180);
+  EXPECT_DOUBLE_EQ(decoded.fx, 199.1);
+  EXPECT_DOUBLE_EQ(decoded.cx, 132.2);
+  EXPECT_EQ(decoded.sensor_distortion, "radtan");
+  EXPECT_EQ(decoded.calibration, "calib.yaml");
+  EXPECT_EQ(decoded.coefficients.size(), 5u);
+  expect_every_prefix_malformed<camera_info_t>(encode(make_camera_info()));
+  stats_t stats;
+  EXPECT_EQ(decode_message(encode(make_camera_info()), stats), WireError::WrongType);
+}
+
 TEST(Messages, AnotherTypeIsWrongTypeNotMalformed) {
   event_batch_t batch;
   EventBatch events;

@@ -12,8 +12,9 @@ int main(int argc, char** argv) {
   CLI::App app{"evldt-export: writes an lcm-logger recording (LOG.lcmlog) of one camera as an MCAP file in Foxglove's\n"
                "schemas, JSON encoding: /<camera>/events (foxglove.CompressedImage: the SCARF surface of the events at\n"
                "--image-hz of recording time), /<camera>/segments and /<camera>/whole_lines (foxglove.ImageAnnotations, whole\n"
-               "lines with their ids), /<camera>/stats (evldt.Stats: evldt-lines' statistics). Open it in Foxglove: an Image panel\n"
-               "on /<camera>/events with both annotation topics."};
+               "lines with their ids), /<camera>/stats (evldt.Stats: evldt-lines' statistics) and, from a run with a calibration,\n"
+               "/<camera>/camera_info (foxglove.CameraCalibration). Open it in Foxglove: an Image panel on /<camera>/events with\n"
+               "both annotation topics."};
   std::filesystem::path log, mcap;
   LogExportOptions options;
   app.add_option("LOG", log, "lcm-logger recording")->required()->check(CLI::ExistingFile);
@@ -29,11 +30,12 @@ int main(int argc, char** argv) {
     if (counts.invalid > 0) spdlog::warn("{} undecodable messages of camera {} skipped", counts.invalid, counts.camera);
     std::printf("evldt-export summary\n"
                 "  camera    %s\n"
-                "  written   %llu pictures, %llu segment lists, %llu whole-line lists, %llu statistics -> %s\n"
+                "  written   %llu pictures, %llu segment lists, %llu whole-line lists, %llu statistics, %llu camera calibrations -> %s\n"
                 "  skipped   %llu undecodable, %llu of other channels or cameras\n"
                 "  damage    %llu bytes in %llu place(s)%s\n",
                 counts.camera.c_str(), static_cast<unsigned long long>(counts.images), static_cast<unsigned long long>(counts.segment_lists),
-                static_cast<unsigned long long>(counts.whole_line_lists), static_cast<unsigned long long>(counts.stats), mcap.string().c_str(),
+                static_cast<unsigned long long>(counts.whole_line_lists), static_cast<unsigned long long>(counts.stats),
+                static_cast<unsigned long long>(counts.camera_infos), mcap.string().c_str(),
                 static_cast<unsigned long long>(counts.invalid), static_cast<unsigned long long>(counts.other_messages),
                 static_cast<unsigned long long>(counts.damage.skipped_bytes), static_cast<unsigned long long>(counts.damage.regions),
                 counts.damage.cut ? ", the last record cut short" : "");

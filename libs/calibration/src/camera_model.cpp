@@ -197,6 +197,7 @@ CameraModel read_camera_model(const std::filesystem::path& path) {
     }
   }
   check(path, model);
+  model.path = path.string();
   return model;
 }
 
@@ -238,6 +239,7 @@ std::shared_ptr<const RectificationTable> rectification_table(const CameraModel&
   const std::vector<float> centres = undistorted_pixel_centres(model, sensor);
   auto table = std::make_shared<RectificationTable>();
   table->sensor = sensor;
+  table->lens = {model.fx, model.fy, model.cx, model.cy, distortion_name(model.distortion), model.coefficients, model.path};
   table->target.resize(centres.size() / 2);
   for (std::size_t i = 0; i < table->target.size(); ++i) {
     const float x = std::floor(centres[2 * i]), y = std::floor(centres[2 * i + 1]);

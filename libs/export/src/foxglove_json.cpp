@@ -73,6 +73,20 @@ const std::string& stats_schema() {
   return schema;
 }
 
+const std::string& camera_calibration_schema() {
+  static const std::string schema =
+    R"({"title": "foxglove.CameraCalibration", "description": "The calibrated camera evldt-lines gives its lines in (CAMERA_INFO_<CAM>): )"
+    R"(K and D of the sensor, P of the rectified image the lines are in", "type": "object", "properties": {)"
+    R"("timestamp": {"type": "object", "properties": {"sec": {"type": "integer", "minimum": 0}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999}}, "required": ["sec", "nsec"]}, )"
+    R"("frame_id": {"type": "string"}, "width": {"type": "integer", "minimum": 0}, "height": {"type": "integer", "minimum": 0}, )"
+    R"("distortion_model": {"type": "string"}, "D": {"type": "array", "items": {"type": "number"}}, )"
+    R"("K": {"type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9}, )"
+    R"("R": {"type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9}, )"
+    R"("P": {"type": "array", "items": {"type": "number"}, "minItems": 12, "maxItems": 12}}, )"
+    R"("required": ["timestamp", "frame_id", "width", "height", "distortion_model", "D", "K", "R", "P"]})";
+  return schema;
+}
+
 std::string base64(std::span<const std::uint8_t> bytes) {
   static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -136,6 +150,26 @@ std::string stats_json(std::uint64_t time_ns, const stats_t& stats) {
                      time_json(time_ns), json_quoted(stats.service), json_quoted(stats.source), stats.events_in, stats.event_rate, stats.batches_received,
                      stats.batches_lost, stats.batches_shed, stats.events_shed, stats.detect_hz, stats.track_hz, stats.live_lines,
                      stats.latency_median_ms, stats.latency_p99_ms, json_quoted(stats.filters), stats.num_masked_pixels);
+}
+
+std::string camera_calibration_json(std::uint64_t time_ns, const camera_info_t& info) {
+  // Foxglove's names of the models: OpenCV's fisheye is Kannala-Brandt; radial-tangential with
+  // 8 coefficients is ROS's rational polynomial, with fewer plumb bob (k1 k2 p1 p2 k3).
+  std::vector<double> d = info.coefficients;
+  std::string model = "plumb_bob";
+  if (info.sensor_distortion == "equidistant") {
+    model = "kannala_brandt";
+  } else if (d.size() == 8) {
+    model = "rational_polynomial";
+  } else {
+    d.resize(5, 0.0);
+  }
+  std::string list;
+  for (const double c : d) list += (list.empty() ? "" : ", ") + fmt::format("{}", c);
+  return fmt::format(R"({{"timestamp": {}, "frame_id": {}, "width": {}, "height": {}, "distortion_model": "{}", "D": [{}], )"
+                     R"("K": [{}, 0, {}, 0, {}, {}, 0, 0, 1], "R": [1, 0, 0, 0, 1, 0, 0, 0, 1], "P": [{}, 0, {}, 0, 0, {}, {}, 0, 0, 0, 1, 0]}})",
+                     time_json(time_ns), json_quoted(info.source), info.width, info.height, model, list, info.fx, info.cx, info.fy, info.cy,
+                     info.fx, info.cx, info.fy, info.cy);
 }
 
 }  // namespace evldt

@@ -58,6 +58,8 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
   const std::uint16_t segment_channel = mcap.add_channel(annotations_schema, prefix + "segments", "json");
   const std::uint16_t whole_line_channel = mcap.add_channel(annotations_schema, prefix + "whole_lines", "json");
   const std::uint16_t stats_channel = mcap.add_channel(stats_schema_id, prefix + "stats", "json");
+  std::optional<std::uint16_t> camera_info_channel_id;  // added with the first CAMERA_INFO message
+  const std::string camera_info = camera_info_channel(counts.camera);
 
   EventBatchReceiver receiver(std::nullopt, /*backwards_slack_us=*/1000);
   EventBatch batch;
@@ -70,6 +72,7 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
   segment_list_t list;
   std::vector<TrackedLine> tracked;
   stats_t stats;
+  camera_info_t info;
   const AnnotationStyle segment_style{.thickness = 1, .by_status = true};
   const AnnotationStyle whole_line_style{.thickness = 2, .by_status = false, .ids = true};
   bool any_batch = false;
@@ -115,6 +118,17 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
       }
       mcap.write(stats_channel, time_ns, stats_json(time_ns, stats));
       ++counts.stats;
+    } else if (event->channel == camera_info) {
+      if (decode_message(event->data, info) != WireError::None) {
+        ++counts.invalid;
+        continue;
+      }
+      if (!camera_info_channel_id) {
+        const std::uint16_t schema = mcap.add_schema("foxglove.CameraCalibration", "jsonschema", camera_calibration_schema());
+        camera_info_channel_id = mcap.add_channel(schema, prefix + "camera_info", "json");
+      }
+      mcap.write(*camera_info_channel_id, time_ns, camera_calibration_json(time_ns, info));
+      ++counts.camera_infos;
     } else {
       ++counts.other_messages;
     }

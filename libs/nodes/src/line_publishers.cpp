@@ -93,6 +93,23 @@ void SegmentListPublisher::hand_on(const std::shared_ptr<RealtimeEngine>& engine
   whole_lines_->hand_over(engine, lines_, header, shedding);
 }
 
+// --- the camera --------------------------------------------------------------------------------
+
+CameraInfoPublisher::CameraInfoPublisher(lcm::LCM& lcm, const LinesNodeOptions& options, std::int64_t epoch_us)
+    : lcm_(lcm), channel_(camera_info_channel(options.camera)) {
+  msg_.epoch = epoch_us;
+  msg_.source = options.camera;
+}
+
+bool CameraInfoPublisher::publish(const RealtimeEngine& engine) {
+  const auto& table = engine.config().rectification;
+  if (!table) return false;
+  fill_camera_info(*table, msg_);
+  msg_.utime = wall_clock_us();
+  if (lcm_.publish(channel_, &msg_) == 0) ++published_;
+  return true;
+}
+
 // --- whole lines -----------------------------------------------------------------------------------
 
 WholeLinePublisher::WholeLinePublisher(lcm::LCM& lcm, const LinesNodeOptions& options, std::int64_t epoch_us, std::uint64_t first_id)

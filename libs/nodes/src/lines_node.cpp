@@ -42,7 +42,8 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
                                                                              static_cast<std::uint64_t>(epoch_us))
                                         : std::nullopt),
       segments_(lcm, options_, epoch_us, ingest_, whole_lines_ ? &*whole_lines_ : nullptr),
-      statistics_(lcm, options_, epoch_us) {
+      statistics_(lcm, options_, epoch_us),
+      camera_info_(lcm, options_, epoch_us) {
   if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100) ||
       !(options_.whole_lines_hz > 0 && options_.whole_lines_hz <= 10000) ||
       !(options_.whole_lines_loaded_hz > 0 && options_.whole_lines_loaded_hz <= 10000)) {
@@ -113,14 +114,20 @@ void LinesNode::publish_loop(const std::atomic<bool>& stop) {
   // unchanged one again after a second (a heartbeat, so a subscriber sees the service live).
   constexpr auto kHeartbeat = std::chrono::seconds(1);
   constexpr auto kLongestWait = std::chrono::milliseconds(100);  // the stop flag is checked this often
+  constexpr auto kCameraInfoPeriod = std::chrono::milliseconds(250);  // with a calibration: a subscriber waits no longer
   const auto publish_period = period_of(options_.publish_hz);
   const auto stats_period = period_of(options_.stats_hz);
   auto next_publish = Clock::now();
   auto last_list = next_publish;
   auto last_stats = next_publish;
   auto last_log = next_publish;
+  auto last_camera_info = next_publish - kCameraInfoPeriod;
   while (!stop.load()) {
     auto now = Clock::now();
+    if (now - last_camera_info >= kCameraInfoPeriod) {
+      if (const auto engine = ingest_.engine()) camera_info_.publish(*engine);
+      last_camera_info = now;
+    }
     if (now >= next_publish && segments_.publish(now - last_list >= kHeartbeat)) {
       last_list = now;
       next_publish = now + publish_period;

@@ -28,6 +28,7 @@ void check_camera_name(std::string_view camera) {
 
 std::string events_channel(std::string_view camera) { return channel("EVENTS_", camera); }
 std::string lines_channel(std::string_view camera) { return channel("LINES_", camera); }
+std::string camera_info_channel(std::string_view camera) { return channel("CAMERA_INFO_", camera); }
 std::string whole_lines_channel(std::string_view camera) { return channel("WHOLE_LINES_", camera); }
 
 std::int64_t wall_clock_us() {

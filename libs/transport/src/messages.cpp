@@ -121,6 +121,29 @@ WireError decode_message(std::span<const std::uint8_t> bytes, stats_t& out) {
   return decode_checked(bytes, out, well_formed);
 }
 
+WireError decode_message(std::span<const std::uint8_t> bytes, camera_info_t& out) {
+  if (bytes.size() > kMaxMessageBytes) return WireError::Malformed;
+  WireWalker walker(bytes);
+  if (const auto hash = check_hash<camera_info_t>(walker); hash != WireError::None) return hash;
+  const bool well_formed = walker.skip(2 * 8) && walker.skip_string() && walker.skip(2 * 2 + 4 * 8) && walker.skip_string() &&
+                           walker.skip_string() && walker.counted_tail(8);
+  return decode_checked(bytes, out, well_formed);
+}
+
+void fill_camera_info(const RectificationTable& table, camera_info_t& msg) {
+  const LensDescription& lens = table.lens;
+  msg.width = static_cast<std::int16_t>(table.sensor.width);
+  msg.height = static_cast<std::int16_t>(table.sensor.height);
+  msg.fx = lens.fx;
+  msg.fy = lens.fy;
+  msg.cx = lens.cx;
+  msg.cy = lens.cy;
+  msg.sensor_distortion = lens.distortion;
+  msg.calibration = lens.calibration;
+  msg.num_coefficients = static_cast<std::int32_t>(lens.coefficients.size());
+  msg.coefficients = lens.coefficients;
+}
+
 namespace {
 
 void put_be(std::uint8_t*& out, std::uint64_t value, int bytes) {

@@ -23,6 +23,7 @@ struct CameraModel {
   /// Equidistant (OpenCV fisheye, ROS and Kalibr equidistant): k1 k2 k3 k4.
   std::vector<double> coefficients;
   std::string format;  ///< the kind of file it came from
+  std::string path;    ///< the file
 };
 
 /// "none", "radtan" or "equidistant".

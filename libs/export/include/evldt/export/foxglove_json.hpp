@@ -9,6 +9,7 @@
 #include <string>
 
 #include "evldt/lines/line_types.hpp"
+#include "evldt/camera_info_t.hpp"
 #include "evldt/stats_t.hpp"
 
 namespace evldt {
@@ -18,6 +19,7 @@ namespace evldt {
 const std::string& compressed_image_schema();   ///< foxglove.CompressedImage
 const std::string& image_annotations_schema();  ///< foxglove.ImageAnnotations
 const std::string& stats_schema();              ///< evldt.Stats
+const std::string& camera_calibration_schema(); ///< foxglove.CameraCalibration
 
 std::string base64(std::span<const std::uint8_t> bytes);
 
@@ -35,5 +37,7 @@ std::string image_annotations_json(std::uint64_t time_ns, std::span<const Tracke
 
 /// The lines service's statistics.
 std::string stats_json(std::uint64_t time_ns, const stats_t& stats);
+/// A CAMERA_INFO message as foxglove.CameraCalibration: K and D the sensor's, P the rectified image's.
+std::string camera_calibration_json(std::uint64_t time_ns, const camera_info_t& info);
 
 }  // namespace evldt

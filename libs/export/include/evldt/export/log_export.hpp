@@ -23,6 +23,7 @@ struct LogExportOptions {
 struct LogExportCounts {
   std::string camera;
   std::uint64_t images = 0, segment_lists = 0, whole_line_lists = 0, stats = 0;
+  std::uint64_t camera_infos = 0;   ///< CAMERA_INFO messages (a run with a calibration)
   std::uint64_t invalid = 0;        ///< messages of the camera's channels that could not be decoded (skipped)
   std::uint64_t other_messages = 0; ///< of other channels or cameras (not exported)
   LogDamage damage;                 ///< what of the log could not be read (also said in a warning)

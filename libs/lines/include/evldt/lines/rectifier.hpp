@@ -4,15 +4,25 @@
 // before storage. An event whose pixel lands off the rectified image is dropped and counted.
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "evldt/events/event.hpp"
 
 namespace evldt {
 
+/// The camera a table was made of, as consumers of the lines need it (CAMERA_INFO messages).
+struct LensDescription {
+  double fx = 0, fy = 0, cx = 0, cy = 0;  ///< of the rectified image, OpenCV's convention
+  std::string distortion;                 ///< of the sensor: "none", "radtan", "equidistant"
+  std::vector<double> coefficients;
+  std::string calibration;                ///< the file it was read from
+};
+
 struct RectificationTable {
   static constexpr std::uint32_t kOff = 0xFFFFFFFFu;
   SensorSize sensor;
+  LensDescription lens;
   /// Per sensor pixel (row-major): its rectified pixel as x | y << 16, or kOff.
   std::vector<std::uint32_t> target;
 };

@@ -21,6 +21,7 @@
 #include "evldt/lines/whole_line_stage.hpp"
 #include "evldt/nodes/lines_ingest.hpp"
 #include "evldt/nodes/lines_options.hpp"
+#include "evldt/camera_info_t.hpp"
 #include "evldt/segment_list_t.hpp"
 
 namespace evldt {
@@ -114,6 +115,22 @@ class SegmentListPublisher {
   Timestamp whole_time_handed_ = 0;                            ///< its lattice time
   std::uint64_t shed_seen_ = 0;                                ///< batches shed when the publisher last looked
   std::chrono::steady_clock::time_point last_shed_{};          ///< when it last saw that number grow
+};
+
+/// The calibrated camera the lines are given in, on CAMERA_INFO_<CAMERA> (camera_info_t), for an
+/// engine that has a calibration.
+class CameraInfoPublisher {
+ public:
+  CameraInfoPublisher(lcm::LCM& lcm, const LinesNodeOptions& options, std::int64_t epoch_us);
+  /// Publishes the camera of `engine`'s calibration; false (nothing sent) without one.
+  bool publish(const RealtimeEngine& engine);
+  [[nodiscard]] std::uint64_t published() const { return published_; }
+
+ private:
+  lcm::LCM& lcm_;
+  std::string channel_;
+  camera_info_t msg_{};
+  std::uint64_t published_ = 0;
 };
 
 /// The list header's fields of a segment_list_t.

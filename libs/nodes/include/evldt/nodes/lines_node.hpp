@@ -46,6 +46,7 @@ class LinesNode {
   std::optional<WholeLinePublisher> whole_lines_;  ///< with options.whole_lines
   SegmentListPublisher segments_;
   LinesStatistics statistics_;
+  CameraInfoPublisher camera_info_;
   lcm::Subscription* subscription_ = nullptr;
   const std::atomic<bool>* stop_ = nullptr;  ///< run()'s, which the handler waits on when the queue is full
 };

@@ -21,6 +21,8 @@ std::string events_channel(std::string_view camera);
 std::string lines_channel(std::string_view camera);
 /// "front" -> "WHOLE_LINES_FRONT": segment lists whose entries are whole lines (whole_lines.hpp).
 std::string whole_lines_channel(std::string_view camera);
+/// "front" -> "CAMERA_INFO_FRONT": the calibrated camera the lines are given in (camera_info_t).
+std::string camera_info_channel(std::string_view camera);
 /// Throws std::invalid_argument unless the camera name is 1-32 letters, digits or '_'.
 void check_camera_name(std::string_view camera);
 

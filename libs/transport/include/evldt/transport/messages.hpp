@@ -14,6 +14,8 @@
 #include "evldt/event_batch_t.hpp"
 #include "evldt/segment_list_t.hpp"
 #include "evldt/stats_t.hpp"
+#include "evldt/camera_info_t.hpp"
+#include "evldt/lines/rectifier.hpp"
 
 namespace evldt {
 
@@ -30,6 +32,7 @@ std::string_view wire_error_name(WireError error);
 /// (event batches: decode_event_batch).
 WireError decode_message(std::span<const std::uint8_t> bytes, segment_list_t& out);
 WireError decode_message(std::span<const std::uint8_t> bytes, stats_t& out);
+WireError decode_message(std::span<const std::uint8_t> bytes, camera_info_t& out);
 
 /// Encodes an event batch straight from `events` into `out` (resized): the bytes lcm-gen's encoder
 /// writes for `header` with its arrays and time base filled from `events` (the header's own arrays
@@ -52,6 +55,8 @@ WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_b
 
 /// Fills the segments of `msg` (header fields are the caller's).
 void fill_segment_list(std::span<const TrackedLine> lines, segment_list_t& msg);
+/// The camera fields of a CAMERA_INFO message (utime, epoch and source are the caller's).
+void fill_camera_info(const RectificationTable& table, camera_info_t& msg);
 /// Replaces `out` with the segments of `msg`; false if any has an unknown status or a non-finite value.
 bool read_segment_list(const segment_list_t& msg, std::vector<TrackedLine>& out);
 
