@@ -191,6 +191,18 @@ def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
     assert shifted == got
 
 
+def test_a_calibration_straightens_the_lines_of_a_scene_seen_through_a_lens():
+    lens = pathlib.Path(__file__).resolve().parents[2] / "tests/data/calibration/davis240c_camera_info.yaml"
+    sim = evldt.simulate("boxes-6dof", duration_s=0.6, lens=str(lens))  # events in sensor pixels
+    scores = {}
+    for name, params in (("raw", {}), ("calibrated", {"calibration": str(lens)})):
+        segments = evldt.Pipeline(sim.width, sim.height, **params).process(sim.events)
+        scores[name] = evldt.evaluate(segments, sim.ground_truth, sim.width, sim.height)["accuracy"][0]["f"]
+    assert scores["calibrated"] > 0.85 and scores["raw"] < scores["calibrated"] - 0.1, scores
+    with pytest.raises(ValueError, match="calibration is of a 240x180 camera, the sensor 346x260"):
+        evldt.Pipeline(346, 260, calibration=str(lens))
+
+
 def test_simulated_ground_truth_equals_evldt_sim_csv(boxes):
     simulated = evldt.simulate("boxes-6dof", duration_s=0.4)
     expected = read_csv(boxes / "evt3" / "ground_truth.csv")
