@@ -96,10 +96,18 @@ TEST(CameraModel, TheLensMovesTheCornersNotTheCentre) {
   const double after = std::hypot(cx - (model.cx + 0.5), cy - (model.cy + 0.5));
   EXPECT_GT(after / before, 1.15);
   EXPECT_LT(after / before, 1.5);
-  // So the table sends the corners off the rectified image, and the centre to itself.
+  // So the corner pixels see beyond the rectified image and feed none of its pixels, the centre
+  // feeds itself, and towards the edges, where the lens squeezes the scene, a sensor pixel feeds
+  // more than one; every rectified pixel is fed.
   const auto table = rectification_table(model, sensor);
-  EXPECT_EQ(table->target[0], RectificationTable::kOff);
-  EXPECT_EQ(table->target[111 * 240 + 132], 132u | 111u << 16);
+  const auto feeds = [&](std::size_t pixel) { return table->first[pixel + 1] - table->first[pixel]; };
+  EXPECT_EQ(feeds(0), 0u);
+  ASSERT_EQ(feeds(111 * 240 + 132), 1u);
+  EXPECT_EQ(table->targets[table->first[111 * 240 + 132]], 132u | 111u << 16);
+  std::size_t squeezed = 0;
+  for (std::size_t pixel = 0; pixel < 240 * 180; ++pixel) squeezed += feeds(pixel) > 1;
+  EXPECT_GT(squeezed, 100u);
+  EXPECT_EQ(table->targets.size(), 240u * 180u);
   EXPECT_THROW(static_cast<void>(rectification_table(read_camera_model(kFixtures / "davis240c_camera_info.yaml"), {346, 260})),
                std::invalid_argument);
 }
@@ -132,20 +140,30 @@ TEST(CameraModel, ABadFileSaysWhichAndWhy) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(Rectifier, MovesEventsToTheirRectifiedPixelsAndCountsThoseOff) {
-  RectificationTable table{{4, 2}, {}, std::vector<std::uint32_t>(8, RectificationTable::kOff)};
-  table.target[1] = 2u | 1u << 16;  // (1, 0) -> (2, 1)
-  table.target[6] = 0u;             // (2, 1) -> (0, 0)
+TEST(Rectifier, MovesEventsToTheRectifiedPixelsTheirPixelFeedsInTurnAndCountsThoseOff) {
+  // Rectified (2, 1) and (3, 1) are seen by sensor pixel (1, 0), rectified (0, 0) by (2, 1).
+  std::vector<std::int32_t> sources(8, -1);
+  sources[6] = 1;
+  sources[7] = 1;
+  sources[0] = 6;
+  const RectificationTable table = RectificationTable::from_sources({4, 2}, sources);
   Rectifier rectifier(table);
   EventBatch in, out;
   in.push_back(10, 1, 0, 1);
-  in.push_back(11, 0, 0, -1);  // off
+  in.push_back(11, 0, 0, -1);  // feeds none
   in.push_back(12, 2, 1, 1);
+  in.push_back(13, 1, 0, -1);  // (1, 0) again: its second rectified pixel
   rectifier.apply(in, out);
-  ASSERT_EQ(out.size(), 2u);
+  ASSERT_EQ(out.size(), 3u);
   EXPECT_EQ(out[0], (Event{10, 2, 1, 1}));
   EXPECT_EQ(out[1], (Event{12, 0, 0, 1}));
+  EXPECT_EQ(out[2], (Event{13, 3, 1, -1}));
   EXPECT_EQ(rectifier.dropped(), 1u);
+  in.clear();
+  in.push_back(14, 1, 0, 1);  // and the first again, in the next batch
+  rectifier.apply(in, out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0], (Event{14, 2, 1, 1}));
 }
 
 EventBatch simulate_all(const Scene& scene, const SimulatorConfig& config) {

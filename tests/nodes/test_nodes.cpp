@@ -397,12 +397,10 @@ TEST(Nodes, WithACalibrationTheLinesComeWithTheirCamera) {
   // A calibration whose table keeps every pixel (libs/calibration makes real ones; tested there).
   options.configure = [](SensorSize sensor) {
     PipelineConfig config = default_config_for(sensor);
-    auto table = std::make_shared<RectificationTable>();
-    table->sensor = sensor;
+    std::vector<std::int32_t> sources(static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height));
+    for (std::size_t i = 0; i < sources.size(); ++i) sources[i] = static_cast<std::int32_t>(i);
+    auto table = std::make_shared<RectificationTable>(RectificationTable::from_sources(sensor, sources));
     table->lens = {199.1, 198.8, 132.2, 110.7, "radtan", {-0.37, 0.15, -0.0003, -0.0008}, "davis240c.yaml"};
-    for (int y = 0; y < sensor.height; ++y) {
-      for (int x = 0; x < sensor.width; ++x) table->target.push_back(static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16);
-    }
     config.calibration = "davis240c.yaml";
     config.rectification = table;
     return config;

@@ -236,16 +236,31 @@ std::shared_ptr<const RectificationTable> rectification_table(const CameraModel&
     throw std::invalid_argument("the calibration is of a " + std::to_string(model.size.width) + "x" + std::to_string(model.size.height) +
                                 " camera, the sensor " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height));
   }
-  const std::vector<float> centres = undistorted_pixel_centres(model, sensor);
-  auto table = std::make_shared<RectificationTable>();
-  table->sensor = sensor;
-  table->lens = {model.fx, model.fy, model.cx, model.cy, distortion_name(model.distortion), model.coefficients, model.path};
-  table->target.resize(centres.size() / 2);
-  for (std::size_t i = 0; i < table->target.size(); ++i) {
-    const float x = std::floor(centres[2 * i]), y = std::floor(centres[2 * i + 1]);
-    const bool inside = x >= 0 && y >= 0 && x < static_cast<float>(sensor.width) && y < static_cast<float>(sensor.height);
-    table->target[i] = inside ? static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16 : RectificationTable::kOff;
+  // Per rectified pixel, where its centre lies on the sensor (OpenCV's maps: a pixel's centre at its
+  // index), and so the sensor pixel that sees it.
+  const cv::Size size(sensor.width, sensor.height);
+  const cv::Matx33d k(model.fx, 0, model.cx, 0, model.fy, model.cy, 0, 0, 1);
+  cv::Mat map_x, map_y;
+  switch (model.distortion) {
+    case CameraModel::Distortion::None: cv::initUndistortRectifyMap(k, cv::noArray(), cv::noArray(), k, size, CV_32FC1, map_x, map_y); break;
+    case CameraModel::Distortion::RadialTangential:
+      cv::initUndistortRectifyMap(k, model.coefficients, cv::noArray(), k, size, CV_32FC1, map_x, map_y);
+      break;
+    case CameraModel::Distortion::Equidistant:
+      cv::fisheye::initUndistortRectifyMap(k, model.coefficients, cv::Matx33d::eye(), k, size, CV_32FC1, map_x, map_y);
+      break;
   }
+  std::vector<std::int32_t> sources(static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height), -1);
+  for (int y = 0; y < sensor.height; ++y) {
+    for (int x = 0; x < sensor.width; ++x) {
+      const float sx = std::round(map_x.at<float>(y, x)), sy = std::round(map_y.at<float>(y, x));
+      if (!(sx >= 0 && sy >= 0 && sx < static_cast<float>(sensor.width) && sy < static_cast<float>(sensor.height))) continue;
+      sources[static_cast<std::size_t>(y) * static_cast<std::size_t>(sensor.width) + static_cast<std::size_t>(x)] =
+          static_cast<std::int32_t>(sy) * sensor.width + static_cast<std::int32_t>(sx);
+    }
+  }
+  auto table = std::make_shared<RectificationTable>(RectificationTable::from_sources(sensor, sources));
+  table->lens = {model.fx, model.fy, model.cx, model.cy, distortion_name(model.distortion), model.coefficients, model.path};
   return table;
 }
 

@@ -40,7 +40,7 @@ CameraModel read_camera_model(const std::filesystem::path& path);
 std::vector<float> undistorted_pixel_centres(const CameraModel& model, SensorSize sensor);
 
 /// The rectification table of `model` for `sensor` (which must be the model's size where it has one):
-/// each sensor pixel goes to the rectified pixel holding its undistorted centre, or off the image.
+/// each rectified pixel is fed by the sensor pixel that sees its centre.
 std::shared_ptr<const RectificationTable> rectification_table(const CameraModel& model, SensorSize sensor);
 
 }  // namespace evldt
