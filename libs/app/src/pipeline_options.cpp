@@ -107,7 +107,13 @@ PipelineConfig PipelineOptions::resolve(SensorSize sensor) const {
     if (values_[i]) parameters[i].set(config, *values_[i]);
   }
   check_filter_config(config.filters);
-  if (config.calibration != "none") config.rectification = rectification_table(read_camera_model(config.calibration), sensor);
+  if (config.calibration != "none") {
+    try {
+      config.rectification = rectification_table(read_camera_model(config.calibration), sensor);
+    } catch (const std::runtime_error& error) {  // a file that cannot be read is a bad value too
+      throw std::invalid_argument(std::string("--calibration ") + error.what());
+    }
+  }
   return config;
 }
 

@@ -22,7 +22,7 @@ class PipelineOptions {
   /// Sensor size given on the command line or in the config file, if any.
   [[nodiscard]] std::optional<SensorSize> sensor() const;
   /// The full configuration for `sensor`: its defaults, then every option that was set.
-  /// Throws std::invalid_argument on a value out of range.
+  /// Throws std::invalid_argument on a value out of range or a calibration file that cannot be read.
   [[nodiscard]] PipelineConfig resolve(SensorSize sensor) const;
   /// --time-slack-us, 1000 unless given.
   [[nodiscard]] Timestamp time_slack_us() const;
