@@ -38,7 +38,7 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
                  filtered.refractory, filtered.anti_flicker);
   }
   if (calibration != "none") {
-    std::fprintf(out, "  calibration      %s: %" PRIu64 " events left out, their pixel off the rectified image\n", calibration.c_str(),
+    std::fprintf(out, "  calibration      %s: %" PRIu64 " events left out, their pixel sees beyond the rectified image\n", calibration.c_str(),
                  counters.off_rectified);
   }
   if (decoded.skipped_words > 0 || decoded.trigger_events > 0) {

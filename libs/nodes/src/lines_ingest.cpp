@@ -19,6 +19,7 @@ constexpr std::size_t kBatchSlotBytes = 64 * 1024;
 void add_counts(EngineCounters& sum, const EngineCounters& engine) {
   sum.events += engine.events;
   sum.events_received += engine.events_received;
+  sum.off_rectified += engine.off_rectified;
   sum.filtered += engine.filtered;
   sum.detect_rounds += engine.detect_rounds;
   sum.detect_rounds_without_bend_test += engine.detect_rounds_without_bend_test;
@@ -164,6 +165,7 @@ void LinesIngest::add_to(LinesNodeTotals& totals) const {
   if (engine) add_counts(all, engine->counters());
   totals.events_stored = all.events;
   totals.events_received = all.events_received;
+  totals.events_off_rectified = all.off_rectified;
   totals.filtered = all.filtered;
   totals.detect_rounds = all.detect_rounds;
   totals.detect_rounds_without_bend_test = all.detect_rounds_without_bend_test;

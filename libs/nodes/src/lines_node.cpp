@@ -25,6 +25,9 @@ void LinesNodeTotals::print(std::FILE* out, const LinesNodeOptions& options) con
              receiver.drops.clock_resets);
   fmt::print(out, "  filters   dropped {} hot-pixel, {} background-activity, {} refractory, {} anti-flicker\n", filtered.hot_pixel,
              filtered.background_activity, filtered.refractory, filtered.anti_flicker);
+  if (events_off_rectified > 0) {  // with a calibration
+    fmt::print(out, "  calibration  {} events left out, their pixel sees beyond the rectified image\n", events_off_rectified);
+  }
   fmt::print(out, "  loops     {} detection rounds ({} while shedding, without the bend test), {} tracking rounds\n", detect_rounds,
              detect_rounds_without_bend_test, track_rounds);
   fmt::print(out, "  output    {} lines created, {} segment lists published, {} whole-line lists ({} at {} Hz while shedding)\n",

@@ -1,8 +1,9 @@
 #pragma once
-// The deterministic pipeline (docs/design.md, section 7), its stages composed in this one place: the noise filters,
-// storage of every event that passes them in the lattice, tracking every track_period_us and
-// detection every detect_period_us of EVENT time, and at each output step, when asked for, the
-// whole lines; so a run's output depends only on its input.
+// The deterministic pipeline (docs/design.md, section 7), its stages composed in this one place:
+// the noise filters, with a calibration the move into the rectified image, storage of every event
+// that passes them in the lattice, tracking every track_period_us and detection every
+// detect_period_us of EVENT time, and at each output step, when asked for, the whole lines; so a
+// run's output depends only on its input.
 
 #include <cstdint>
 #include <functional>
@@ -21,7 +22,7 @@ struct PipelineCounters {
   std::uint64_t detect_rounds = 0;
   std::uint64_t skipped_rounds = 0;  ///< rounds not run across long gaps in event time
   std::uint64_t clock_restarts = 0;  ///< schedules begun again because event time went back
-  std::uint64_t off_rectified = 0;   ///< events whose pixel lies off the rectified image (with a calibration)
+  std::uint64_t off_rectified = 0;   ///< with a calibration: events whose pixel feeds no rectified pixel
 };
 
 /// A batch starting this far before the next due round means the clock went back (an EventValidator

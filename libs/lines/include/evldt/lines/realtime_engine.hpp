@@ -30,7 +30,7 @@ struct EngineCounters {
   FilterCounts filtered;             ///< what the noise filters let through and dropped
   std::uint64_t events_received = 0;  ///< handed to process()
   std::uint64_t events = 0;           ///< stored
-  std::uint64_t off_rectified = 0;    ///< left out: their pixel lies off the rectified image (with a calibration)
+  std::uint64_t off_rectified = 0;    ///< with a calibration: left out, their pixel feeds no rectified pixel
   std::uint64_t detect_rounds = 0;
   std::uint64_t detect_rounds_without_bend_test = 0;  ///< those run while shedding
   std::uint64_t track_rounds = 0;

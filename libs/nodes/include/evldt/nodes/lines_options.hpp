@@ -46,6 +46,7 @@ struct LinesNodeTotals {
   std::uint64_t events_received = 0;  ///< valid events handed to the engine
   FilterCounts filtered;              ///< what the noise filters dropped of them
   std::uint64_t events_stored = 0;
+  std::uint64_t events_off_rectified = 0;  ///< with a calibration: left out, their pixel feeds no rectified pixel
   std::uint64_t detect_rounds = 0;
   std::uint64_t detect_rounds_without_bend_test = 0;  ///< run while shedding
   std::uint64_t track_rounds = 0;
