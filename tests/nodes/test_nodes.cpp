@@ -483,6 +483,45 @@ TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   expect_ids_apart(whole_collector.lists());  // so do the whole lines'
 }
 
+TEST(Nodes, VizTakesACameraClockInUnixTime) {
+  // A live camera's events stamped in Unix microseconds: drawn, and the time shown from the first.
+  lcm::LCM lcm("memq://");
+  VizNodeOptions options;
+  options.render_hz = 200;
+  options.render.scale = 2;
+  VizNode viz(lcm, options);
+  constexpr Timestamp kEpochCameraUs = 1'700'000'000'000'000;
+  EventBatch events;
+  for (std::uint16_t y = 20; y < 120; ++y) events.push_back(kEpochCameraUs + y, 50, y, 1);
+  event_batch_t batch;
+  batch.width = 240;
+  batch.height = 180;
+  std::vector<std::uint8_t> bytes;
+  encode_event_batch(batch, events, bytes);
+  publish_raw(lcm, "EVENTS_CAM0", bytes);
+  TrackedLine line;
+  line.id = 3;
+  line.segment = {Point2(150.5f, 20.5f), Point2(150.5f, 160.5f)};
+  line.status = LineStatus::GoodTrack;
+  segment_list_t list;
+  fill_segment_list(std::span<const TrackedLine>(&line, 1), list);
+  list.width = 240;
+  list.height = 180;
+  list.t_us = kEpochCameraUs + 250'000;
+  publish_raw(lcm, "LINES_CAM0", encode(list));
+  cv::Mat last;
+  const std::atomic<bool> never{false};
+  viz.run(never, [&](const cv::Mat& frame) {
+    frame.copyTo(last);
+    return viz.totals().frames < 2;
+  });
+  EXPECT_EQ(viz.totals().segment_lists, 1u);
+  EXPECT_EQ(viz.totals().events.invalid_messages, 0u);
+  EXPECT_GT(last.at<cv::Vec3b>(2 * 70, 2 * 50)[0], 40);  // the events' column, at twice the scale
+  ASSERT_FALSE(viz.status().empty());
+  EXPECT_EQ(viz.status()[0][1], "t=0.250 s");
+}
+
 TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
   lcm::LCM lcm("memq://");
   VizNodeOptions options;
