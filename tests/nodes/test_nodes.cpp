@@ -483,6 +483,30 @@ TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   expect_ids_apart(whole_collector.lists());  // so do the whole lines'
 }
 
+// What the viz tests draw from: a vertical run of events at x = 50 from time t0 on, and a good track
+// at x = 150.5 in a list of event time list_t.
+void publish_column_and_line(lcm::LCM& lcm, Timestamp t0, Timestamp list_t) {
+  EventBatch events;
+  for (std::uint16_t y = 20; y < 120; ++y) events.push_back(t0 + y, 50, y, 1);
+  event_batch_t batch;
+  batch.width = 240;
+  batch.height = 180;
+  std::vector<std::uint8_t> bytes;
+  encode_event_batch(batch, events, bytes);
+  publish_raw(lcm, "EVENTS_CAM0", bytes);
+  TrackedLine line;
+  line.id = 9;
+  line.segment = {Point2(150.5f, 20.5f), Point2(150.5f, 160.5f)};
+  line.score = 0.9f;
+  line.status = LineStatus::GoodTrack;
+  segment_list_t list;
+  fill_segment_list(std::span<const TrackedLine>(&line, 1), list);
+  list.width = 240;
+  list.height = 180;
+  list.t_us = list_t;
+  publish_raw(lcm, "LINES_CAM0", encode(list));
+}
+
 TEST(Nodes, VizTakesACameraClockInUnixTime) {
   // A live camera's events stamped in Unix microseconds: drawn, and the time shown from the first.
   lcm::LCM lcm("memq://");
@@ -491,24 +515,7 @@ TEST(Nodes, VizTakesACameraClockInUnixTime) {
   options.render.scale = 2;
   VizNode viz(lcm, options);
   constexpr Timestamp kEpochCameraUs = 1'700'000'000'000'000;
-  EventBatch events;
-  for (std::uint16_t y = 20; y < 120; ++y) events.push_back(kEpochCameraUs + y, 50, y, 1);
-  event_batch_t batch;
-  batch.width = 240;
-  batch.height = 180;
-  std::vector<std::uint8_t> bytes;
-  encode_event_batch(batch, events, bytes);
-  publish_raw(lcm, "EVENTS_CAM0", bytes);
-  TrackedLine line;
-  line.id = 3;
-  line.segment = {Point2(150.5f, 20.5f), Point2(150.5f, 160.5f)};
-  line.status = LineStatus::GoodTrack;
-  segment_list_t list;
-  fill_segment_list(std::span<const TrackedLine>(&line, 1), list);
-  list.width = 240;
-  list.height = 180;
-  list.t_us = kEpochCameraUs + 250'000;
-  publish_raw(lcm, "LINES_CAM0", encode(list));
+  publish_column_and_line(lcm, kEpochCameraUs, kEpochCameraUs + 250'000);
   cv::Mat last;
   const std::atomic<bool> never{false};
   viz.run(never, [&](const cv::Mat& frame) {
@@ -529,24 +536,7 @@ TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
   options.render.scale = 2;
   VizNode viz(lcm, options);
 
-  EventBatch events;  // a vertical run of events at x = 50
-  for (std::uint16_t y = 20; y < 120; ++y) events.push_back(1000 + y, 50, y, 1);
-  event_batch_t batch;
-  batch.width = 240;
-  batch.height = 180;
-  std::vector<std::uint8_t> bytes;
-  encode_event_batch(batch, events, bytes);
-  publish_raw(lcm, "EVENTS_CAM0", bytes);
-  TrackedLine line;
-  line.id = 9;
-  line.segment = {Point2(150.5f, 20.5f), Point2(150.5f, 160.5f)};
-  line.score = 0.9f;
-  line.status = LineStatus::GoodTrack;
-  segment_list_t list;
-  fill_segment_list(std::span<const TrackedLine>(&line, 1), list);
-  list.width = 240;
-  list.height = 180;
-  publish_raw(lcm, "LINES_CAM0", encode(list));
+  publish_column_and_line(lcm, 1000, 0);
   publish_raw(lcm, "LINES_CAM0", {1, 2, 3});  // refused, counted
   stats_t stats{};  // evldt-lines masks the hot pixel (200, 40); evldt-camera's statistics are not drawn
   stats.service = "evldt-lines";
