@@ -408,7 +408,11 @@ TEST(Nodes, WithACalibrationTheLinesComeWithTheirCamera) {
   RunningLines lines(lcm, 4'000'000, options);
   const std::atomic<bool> never{false};
   const CameraSummary sent = CameraNode(lcm, fast_camera(), 1).run(scene_source("boxes-6dof", 200'000), never);
-  ASSERT_TRUE(wait_for([&] { return cameras.infos().size() >= 2 && !collector.lists().empty(); }));
+  // Until a list holds the last batch (every event stored), and the camera came twice.
+  ASSERT_TRUE(wait_for([&] {
+    const auto lists = collector.lists();
+    return cameras.infos().size() >= 2 && !lists.empty() && lists.back().newest_batch_seq == static_cast<std::int64_t>(sent.batches - 1);
+  }));
   lines.stop();
   const camera_info_t info = cameras.infos().back();
   EXPECT_EQ(info.source, "cam0");
