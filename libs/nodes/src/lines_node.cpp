@@ -37,6 +37,7 @@ void LinesNodeTotals::print(std::FILE* out, const LinesNodeOptions& options) con
   fmt::print(out, "            the first batch: median {:.1f} ms, p99 {:.1f} ms ({} batches)\n", settled_latency.median_ms,
              settled_latency.p99_ms, settled_latency.samples);
 }
+
 LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch_us)
     : lcm_(lcm),
       options_(std::move(options)),
