@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <optional>
 #include <spdlog/spdlog.h>
 
 #include "evldt/app/lcm_options.hpp"
@@ -62,8 +63,15 @@ int main(int argc, char** argv) {
     options.camera = lcm_options.camera();
     options.sensor = pipeline_options.sensor();
     options.time_slack_us = pipeline_options.time_slack_us();
-    options.configure = [&](SensorSize sensor) { return pipeline_options.resolve(sensor); };
-    if (options.sensor) (void)pipeline_options.resolve(*options.sensor);  // a bad value fails now, not at the first batch
+    // The last sensor's configuration is kept: with a calibration, resolving builds a per-pixel table
+    // (a tenth of a second at 1280x720), which the check at start, the sensor check of the first
+    // batch and the engine would otherwise each build again. Called from one thread at a time.
+    std::optional<PipelineConfig> resolved;
+    options.configure = [&](SensorSize sensor) {
+      if (!resolved || !(resolved->lattice.sensor == sensor)) resolved = pipeline_options.resolve(sensor);
+      return *resolved;
+    };
+    if (options.sensor) (void)options.configure(*options.sensor);  // a bad value fails now, not at the first batch
     const auto& stop = stop_on_signals();
     // This thread handles LCM and starts the store thread: both above the rounds, which must take
     // what the cores have left, not delay storage.

@@ -427,6 +427,23 @@ TEST(Nodes, WithACalibrationTheLinesComeWithTheirCamera) {
   EXPECT_EQ(lines.node.totals().events_received, sent.events_published);
 }
 
+TEST(Nodes, ASensorTheConfigurationRefusesIsCountedNotFatal) {
+  // A calibration of a 240x180 camera, and a 346x260 camera on the channel: its batches are refused
+  // and counted, and the service goes on.
+  lcm::LCM lcm("memq://");
+  LinesNodeOptions options = quiet_lines();
+  options.configure = [](SensorSize sensor) {
+    if (!(sensor == SensorSize{240, 180})) throw std::invalid_argument("the calibration is of a 240x180 camera");
+    return default_config_for(sensor);
+  };
+  RunningLines lines(lcm, 6'000'000, options);
+  const std::atomic<bool> never{false};
+  const CameraSummary sent = CameraNode(lcm, fast_camera(), 1).run(scene_source("multi-speed", 100'000), never);
+  ASSERT_TRUE(wait_for([&] { return lines.node.totals().receiver.invalid_messages == sent.batches; }));
+  lines.stop();
+  EXPECT_EQ(lines.node.totals().events_received, 0u);
+}
+
 TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   lcm::LCM lcm("memq://");
   ListCollector collector(lcm, "LINES_CAM0");

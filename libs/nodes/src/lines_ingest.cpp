@@ -1,6 +1,7 @@
 #include "evldt/nodes/lines_ingest.hpp"
 
 #include <bit>
+#include <stdexcept>
 #include <spdlog/spdlog.h>
 
 #include "evldt/lines/thread_name.hpp"
@@ -32,7 +33,18 @@ LinesIngest::LinesIngest(const LinesNodeOptions& options, std::uint64_t first_li
     : options_(options),
       queue_(kQueuedBatches, kBatchSlotBytes),
       receiver_(options_.sensor, options_.time_slack_us,
-                [this](SensorSize size) { return LatticeGeometry::fits(size, options_.configure(size).lattice.block_size); }),
+                [this](SensorSize size) {
+                  // A size the configuration refuses (a calibration of another camera) is refused
+                  // here, counted as invalid, not thrown out of the storing thread.
+                  try {
+                    return LatticeGeometry::fits(size, options_.configure(size).lattice.block_size);
+                  } catch (const std::invalid_argument& error) {
+                    if (std::has_single_bit(++sizes_refused_)) {  // the 1st, 2nd, 4th, ... time
+                      spdlog::warn("a {}x{} sensor refused ({} time(s)): {}", size.width, size.height, sizes_refused_, error.what());
+                    }
+                    return false;
+                  }
+                }),
       budget_(options_.max_latency_ms, 2'000'000, options_.overload),
       next_line_id_(first_line_id) {
   batch_.reserve_touched(1 << 16);
