@@ -124,6 +124,20 @@ tr -d ' \n' <"$work/support.json" | grep -qP '"whole_line_support":\{"steps":4[0
 grep -q "give --segments too" "$work/support_alone.err" || fail "--whole-lines alone: $(cat "$work/support_alone.err")"
 echo "ok: whole-line support $file_support from the CSVs, $in_process_support in process"
 
+# Recall per true edge: multi-speed's bars move sideways, so their horizontal edges run along their
+# own motion and give no events; the vertical ones cross the sensor at 15 to 500 px/s.
+"$eval" --scene multi-speed --duration-s 0.5 --log-level warn --edge-recall "$work/edges.csv" >"$work/edges.txt"
+grep -q "recall per true edge, multi-speed whole" "$work/edges.txt" || fail "no edge-recall tables: $(cat "$work/edges.txt")"
+head -1 "$work/edges.csv" | grep -qx "run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched" ||
+  fail "edge-recall CSV header: $(head -1 "$work/edges.csv")"
+awk -F, '$1 == "multi-speed whole" && $5 != "" { if ($5 < 2) { sp += $7; sm += $8 } else if ($5 >= 10) { mp += $7; mm += $8 } }
+  END { printf "%.3f %.3f\n", sm / sp, mm / mp; exit !(sp > 0 && mp > 0 && mm / mp >= 0.8 && sm / sp <= 0.4) }' \
+  "$work/edges.csv" >"$work/edges_recall.txt" || fail "edge recall of still / moving edges: $(cat "$work/edges_recall.txt")"
+"$eval" --segments "$work/p.csv" --scene boxes-6dof --edge-recall "$work/no.csv" 2>"$work/edges_bad.err" &&
+  fail "--edge-recall with --segments must fail"
+grep -q "edge-recall scores the pipeline's run" "$work/edges_bad.err" || fail "--edge-recall with --segments: $(cat "$work/edges_bad.err")"
+echo "ok: recall per true edge, still / moving across themselves: $(cat "$work/edges_recall.txt")"
+
 # Every ground-truth step counts: an empty prediction is no score, one step of prediction is
 # charged for all the others, and the GT CSV and the scene give the same steps.
 head -1 "$work/p.csv" >"$work/empty.csv"

@@ -617,5 +617,52 @@ TEST(WholeLineSupport, CountsTheLengthNearASegmentAndTheWeakLines) {
   EXPECT_THROW(WholeLineSupport(2.0f, 1.5f), std::invalid_argument);
 }
 
+
+// Recall per true edge (--edge-recall): a line moving down 2 px a step, found at every step, and a
+// still one 30-20 px below it, never found.
+TEST(EdgeRecall, CountsEachEdgesPixelsAndMatchesWithItsSpeedAndParallelGap) {
+  GroundTruthSteps truth = moving_truth();
+  truth.segments_at = [](std::size_t index, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments = {moving_line(index), row_segment(40, 10, 30)};
+    ids = {3, 7};
+  };
+  StreamEvaluator evaluator(kSensor, {0.01}, truth, std::llround(StreamEvaluator::kHoldPeriods * kGtPeriod));
+  evaluator.keep_edge_recall();
+  for (int k = 0; k < kGtSteps; ++k) predict(evaluator, k * kGtPeriod, 1, {moving_line(static_cast<std::size_t>(k))});
+  evaluator.finish();
+  ASSERT_TRUE(evaluator.edge_recall());
+  const std::vector<EdgeStep>& steps = evaluator.edge_recall()->steps();
+  ASSERT_EQ(steps.size(), 2u * kGtSteps);
+  for (int k = 0; k < kGtSteps; ++k) {
+    const EdgeStep& moving = steps[2 * static_cast<std::size_t>(k)];
+    const EdgeStep& still = steps[2 * static_cast<std::size_t>(k) + 1];
+    EXPECT_EQ(moving.id, 3u);
+    EXPECT_EQ(moving.pixels, 41u);
+    EXPECT_EQ(moving.matched, 41u);
+    EXPECT_EQ(still.id, 7u);
+    EXPECT_EQ(still.pixels, 21u);
+    EXPECT_EQ(still.matched, 0u);
+    EXPECT_FLOAT_EQ(moving.parallel_gap_px, static_cast<float>(30 - 2 * k));
+    EXPECT_FLOAT_EQ(still.parallel_gap_px, static_cast<float>(30 - 2 * k));
+    if (k == 0) {
+      EXPECT_TRUE(std::isnan(moving.normal_speed_px_s));  // no step before
+      EXPECT_TRUE(std::isnan(still.normal_speed_px_s));
+    } else {
+      EXPECT_NEAR(moving.normal_speed_px_s, 2.0f / (kGtPeriod * 1e-6f), 1.0f);  // 2 px in 10 us
+      EXPECT_EQ(still.normal_speed_px_s, 0.0f);
+    }
+  }
+  const double edges[] = {0, 1, std::numeric_limits<double>::infinity()};
+  const auto bins = bin_edge_recall(steps, EdgeMeasure::NormalSpeed, edges);
+  ASSERT_EQ(bins.size(), 2u);
+  EXPECT_EQ(bins[0].pixels, 21u * (kGtSteps - 1));  // the first step has no speed, so no bin
+  EXPECT_EQ(bins[0].matched, 0u);
+  EXPECT_EQ(bins[1].pixels, 41u * (kGtSteps - 1));
+  EXPECT_EQ(bins[1].matched, 41u * (kGtSteps - 1));
+  const std::string csv = edge_recall_csv_rows("run", steps);
+  EXPECT_NE(csv.find("run,0,3,40.000,,30.000,41,41\n"), std::string::npos) << csv;
+  EXPECT_NE(edge_recall_tables(steps).find("speed across itself"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace evldt

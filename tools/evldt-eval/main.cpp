@@ -29,7 +29,8 @@ namespace {
 using namespace evldt;
 
 struct Options {
-  std::filesystem::path segments, whole_lines, ground_truth, frames_gt, write_gt, json, pr_png, lifetime_png, tracks_png, overlay;
+  std::filesystem::path segments, whole_lines, ground_truth, frames_gt, write_gt, json, pr_png, lifetime_png, tracks_png, overlay,
+      edge_recall;
   LsdParams lsd;
   std::string lcm_channel;
   std::string label;  ///< of the --segments row
@@ -55,6 +56,7 @@ struct Report {
   TrackingSummary tracking;
   std::optional<SupportSummary> support;  ///< whole lines: their support by the segments of their step
   std::vector<Prf> per_second;            ///< cumulative, at the first tolerance
+  std::vector<EdgeStep> edge_steps;       ///< with --edge-recall: each true edge at each step
   std::uint64_t events = 0;
   double scene_seconds = 0, wall_seconds = 0;
 };
@@ -71,6 +73,7 @@ Report make_report(const StreamEvaluator& evaluator) {
   r.lifetime = evaluator.lifetimes().summary();
   r.tracking = evaluator.tracking().summary();
   r.per_second = evaluator.cumulative_per_second();
+  if (evaluator.edge_recall()) r.edge_steps = evaluator.edge_recall()->steps();
   return r;
 }
 
@@ -315,6 +318,19 @@ void write_run_plots(const Options& options, const StreamEvaluator& evaluator, c
   }
 }
 
+// --edge-recall: each run's recall by the true edges' speed, length and nearest parallel edge, and
+// every edge at every step as CSV.
+void write_edge_recall(const std::vector<Report>& reports, const std::filesystem::path& path) {
+  std::ofstream out(path);
+  out << edge_recall_csv_header();
+  for (const Report& r : reports) {
+    std::printf("\nrecall per true edge, %s (first tolerance):\n%s", r.label.c_str(), edge_recall_tables(r.edge_steps).c_str());
+    out << edge_recall_csv_rows(r.label, r.edge_steps);
+  }
+  if (!out) throw std::runtime_error("error writing " + path.string());
+  spdlog::info("wrote the recall of every true edge at every step to {}", path.string());
+}
+
 int run(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim) {
   std::vector<Report> reports;
   std::optional<StreamEvaluator> last;
@@ -336,6 +352,10 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       if (!json.done() || !out) throw std::runtime_error("error writing " + options.json.string());
     }
     return 0;
+  }
+  if (!options.edge_recall.empty() && !options.segments.empty()) {
+    spdlog::error("--edge-recall scores the pipeline's run on --scene (without --segments)");
+    return 1;
   }
   if (!options.overlay.empty() && (options.segments.empty() || options.frames_gt.empty())) {
     spdlog::error("--overlay draws the frames of --frames-gt with the lines of --segments: give both");
@@ -379,6 +399,10 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       spdlog::error("give --segments FILE, or --scene NAME to run the pipeline on a built-in scene");
       return 1;
     }
+    if (!options.edge_recall.empty() && !options.frames_gt.empty()) {
+      spdlog::error("--edge-recall needs the scene's exact edges: LSD's lines (--frames-gt) have no ids that last");
+      return 1;
+    }
     const Scene scene = sim.scene();
     const PipelineConfig base = pipeline_options.resolve(scene.sensor);
     std::vector<float> thresholds = options.pr_thresholds;
@@ -391,6 +415,10 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       const auto started = std::chrono::steady_clock::now();
       last.emplace(scene.sensor, options.tolerances, truth, hold_us);
       StreamEvaluator whole(scene.sensor, options.tolerances, truth, hold_us);
+      if (!options.edge_recall.empty()) {
+        last->keep_edge_recall();
+        whole.keep_edge_recall();
+      }
       const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, result.events, wall);
@@ -422,6 +450,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     if (r.support) print_support(r.label, *r.support);
   }
   if (options.per_second) print_per_second(reports, options);
+  if (!options.edge_recall.empty()) write_edge_recall(reports, options.edge_recall);
   if (!options.json.empty()) write_json(reports, options);
   if (!options.pr_png.empty()) {
     std::vector<PrPoint> points;
@@ -492,6 +521,10 @@ int main(int argc, char** argv) {
                  "With --segments and --frames-gt: a folder of one PNG per scored frame, the frame with LSD's lines\n"
                  "(green), the segments held at its time (red) and the --whole-lines (blue)");
   app.add_option("--pr-png", options.pr_png, "Plot precision/recall over the thresholds (first tolerance)");
+  app.add_option("--edge-recall", options.edge_recall,
+                 "Scene runs: print the recall by the true edges' speed across themselves, length and distance to the "
+                 "nearest parallel edge, and write every true edge at every step to this CSV "
+                 "(run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched)");
   app.add_option("--lifetime-png", options.lifetime_png,
                  "Histogram of segment lifetimes (with --pr-thresholds one file per run, NAME-f<threshold>.png)");
   app.add_option("--tracks-png", options.tracks_png,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -74,23 +75,28 @@ std::optional<Segment> clipped_to_sensor(const Segment& s, SensorSize sensor) {
                  Point2(static_cast<float>(x0 + t1 * dx), static_cast<float>(y0 + t1 * dy))};
 }
 
+void for_each_segment_sample(const Segment& s, SensorSize sensor, const std::function<void(int x, int y)>& visit) {
+  if (!s.q0.allFinite() || !s.q1.allFinite()) return;
+  const double x0 = s.q0.x(), y0 = s.q0.y();
+  const double dx = static_cast<double>(s.q1.x()) - x0, dy = static_cast<double>(s.q1.y()) - y0;
+  double t0 = 0, t1 = 1;
+  if (!clip_to_sensor(x0, y0, dx, dy, sensor, t0, t1)) return;
+  const double length = std::hypot(dx, dy) * (t1 - t0);
+  const int steps = std::max(1, static_cast<int>(std::ceil(length / kRasterStepPx)));
+  for (int i = 0; i <= steps; ++i) {
+    const double t = t0 + (t1 - t0) * i / steps;
+    const double x = std::floor(x0 + t * dx), y = std::floor(y0 + t * dy);
+    // Compared as doubles first so that the int conversion below is always in range.
+    if (x < 0 || y < 0 || x >= sensor.width || y >= sensor.height) continue;
+    visit(static_cast<int>(x), static_cast<int>(y));
+  }
+}
+
 void rasterise(std::span<const Segment> segments, SensorSize sensor, std::vector<std::uint8_t>& map) {
   map.assign(pixel_count(sensor), 0);
+  const auto width = static_cast<std::size_t>(sensor.width);
   for (const Segment& s : segments) {
-    if (!s.q0.allFinite() || !s.q1.allFinite()) continue;
-    const double x0 = s.q0.x(), y0 = s.q0.y();
-    const double dx = static_cast<double>(s.q1.x()) - x0, dy = static_cast<double>(s.q1.y()) - y0;
-    double t0 = 0, t1 = 1;
-    if (!clip_to_sensor(x0, y0, dx, dy, sensor, t0, t1)) continue;
-    const double length = std::hypot(dx, dy) * (t1 - t0);
-    const int steps = std::max(1, static_cast<int>(std::ceil(length / kRasterStepPx)));
-    for (int i = 0; i <= steps; ++i) {
-      const double t = t0 + (t1 - t0) * i / steps;
-      const double x = std::floor(x0 + t * dx), y = std::floor(y0 + t * dy);
-      // Compared as doubles first so that the int conversion below is always in range.
-      if (x < 0 || y < 0 || x >= sensor.width || y >= sensor.height) continue;
-      map[static_cast<std::size_t>(y) * sensor.width + static_cast<std::size_t>(x)] = 1;
-    }
+    for_each_segment_sample(s, sensor, [&](int x, int y) { map[static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)] = 1; });
   }
 }
 
@@ -136,6 +142,14 @@ MatchCounts HeatmapMatcher::match(std::span<const Segment> predicted, std::span<
   rasterise(predicted, sensor_, predicted_map_);
   rasterise(ground_truth, sensor_, ground_truth_map_);
   return match_maps(predicted_map_, ground_truth_map_);
+}
+
+void HeatmapMatcher::matched_ground_truth(std::vector<std::uint8_t>& map) const {
+  map.assign(pixel_count(sensor_), 0);
+  for (std::size_t i = 0; i < bucketed_.size(); ++i) {
+    if (mate_of_ground_truth_[i] == kNone) continue;
+    map[static_cast<std::size_t>(bucketed_[i].y) * static_cast<std::size_t>(sensor_.width) + static_cast<std::size_t>(bucketed_[i].x)] = 1;
+  }
 }
 
 MatchCounts HeatmapMatcher::match_maps(std::span<const std::uint8_t> predicted_map,

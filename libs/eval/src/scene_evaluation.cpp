@@ -91,6 +91,8 @@ StreamEvaluator::StreamEvaluator(SensorSize sensor, std::vector<double> toleranc
   coverage_.ground_truth_steps = ground_truth_.times.size();
 }
 
+void StreamEvaluator::keep_edge_recall() { edge_recall_.emplace(matchers_.front().sensor()); }
+
 void StreamEvaluator::score_steps_before(Timestamp until) {
   const std::vector<Timestamp>& times = ground_truth_.times;
   for (; next_step_ < times.size() && times[next_step_] < until; ++next_step_) {
@@ -106,6 +108,10 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
     const Timestamp t = times[next_step_];
     add_to_second(t, counts_[0]);
     tracking_.add_step(t, predicted_ids, predicted, truth_ids_, truth_);
+    if (edge_recall_) {
+      matchers_.front().matched_ground_truth(matched_map_);
+      edge_recall_->add_step(t, truth_, truth_ids_, matched_map_);
+    }
   }
 }
 

@@ -4,6 +4,7 @@
 // tolerance that is a fraction of the image diagonal. Precision, recall and F follow from the counts.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
@@ -18,6 +19,10 @@ inline constexpr double kRasterStepPx = 0.25;
 
 /// The part of a segment on the sensor [0, W] x [0, H], or nothing (also for a non-finite end).
 [[nodiscard]] std::optional<Segment> clipped_to_sensor(const Segment& segment, SensorSize sensor);
+
+/// Calls visit(x, y) for the pixel of each sample of the segment that rasterise draws, in order
+/// from q0 (a pixel comes once per sample in it, so mostly several times).
+void for_each_segment_sample(const Segment& segment, SensorSize sensor, const std::function<void(int x, int y)>& visit);
 
 /// Draws the segments into a W*H row-major map (resized and cleared here): a pixel is 1 where some
 /// sample of a segment, taken at most kRasterStepPx apart and including both ends, falls in it.
@@ -73,6 +78,10 @@ class HeatmapMatcher {
   /// throws std::invalid_argument if a map has the wrong size.
   [[nodiscard]] MatchCounts match_maps(std::span<const std::uint8_t> predicted_map,
                                        std::span<const std::uint8_t> ground_truth_map);
+
+  /// The ground-truth pixels the last match paired with a predicted one, as a W*H row-major map
+  /// (resized here): 1 where matched.
+  void matched_ground_truth(std::vector<std::uint8_t>& map) const;
 
   [[nodiscard]] SensorSize sensor() const { return sensor_; }
   [[nodiscard]] double tolerance_px() const { return tolerance_px_; }

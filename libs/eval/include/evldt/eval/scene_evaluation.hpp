@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "evldt/eval/accumulator.hpp"
+#include "evldt/eval/edge_recall.hpp"
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/eval/tracking_metrics.hpp"
 #include "evldt/eval/whole_line_support.hpp"
@@ -81,6 +82,10 @@ class StreamEvaluator {
   [[nodiscard]] std::vector<Prf> cumulative_per_second() const;
   static constexpr std::uint64_t kMaxSeconds = 1'000'000;  ///< of the per-second table: 11.6 days
   [[nodiscard]] Timestamp hold_us() const { return hold_us_; }
+  /// Also keep the recall of each true edge at each step, at the first tolerance (before any step).
+  void keep_edge_recall();
+  /// The recall per edge, when kept.
+  [[nodiscard]] const std::optional<EdgeRecall>& edge_recall() const { return edge_recall_; }
   [[nodiscard]] const GroundTruthSteps& ground_truth() const { return ground_truth_; }
 
  private:
@@ -108,6 +113,8 @@ class StreamEvaluator {
   std::vector<MatchCounts> counts_;
   StepCoverage coverage_;
   bool finished_ = false;
+  std::optional<EdgeRecall> edge_recall_;
+  std::vector<std::uint8_t> matched_map_;  // scratch of the edge recall
 };
 
 /// Scores predicted segment rows (of a CSV, a log or Python; any order, sorted by time here) on

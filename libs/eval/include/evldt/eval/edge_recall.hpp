@@ -1,0 +1,67 @@
+#pragma once
+// Recall per ground-truth edge (issue 52): which true edges a method misses, against what makes an
+// edge hard to see - its image speed across itself (an event camera sees an edge only as it moves
+// across itself), its length, and how close the nearest parallel edge lies (two edges in one block).
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "evldt/events/event.hpp"
+#include "evldt/lines/geometry.hpp"
+
+namespace evldt {
+
+/// One visible piece of a true edge at one ground-truth step.
+struct EdgeStep {
+  Timestamp t_us = 0;
+  std::uint64_t id = 0;
+  float length_px = 0;
+  /// How fast the edge's line moved across itself since the previous step, px/s (NaN at its first step).
+  float normal_speed_px_s = 0;
+  /// Distance to the nearest other true edge within kParallelDegrees that overlaps it along its
+  /// length, px (infinite when there is none).
+  float parallel_gap_px = 0;
+  std::uint32_t pixels = 0;   ///< its pixels in the ground-truth line map
+  std::uint32_t matched = 0;  ///< of them, matched to a predicted pixel
+};
+
+class EdgeRecall {
+ public:
+  static constexpr float kParallelDegrees = 10;
+
+  explicit EdgeRecall(SensorSize sensor) : sensor_(sensor) {}
+  /// One scored step: the true pieces and their line ids, and the ground-truth pixels the matcher
+  /// paired (HeatmapMatcher::matched_ground_truth). A pixel two pieces share counts for both.
+  void add_step(Timestamp t, std::span<const Segment> truth, std::span<const std::uint64_t> ids,
+                std::span<const std::uint8_t> matched_map);
+  [[nodiscard]] const std::vector<EdgeStep>& steps() const { return steps_; }
+
+ private:
+  SensorSize sensor_;
+  std::vector<EdgeStep> steps_;
+  struct Seen {
+    Timestamp t_us;
+    Segment first_piece;
+  };
+  std::unordered_map<std::uint64_t, Seen> previous_;  // per line id: its first piece at its last step
+  std::vector<std::uint32_t> pixels_;                 // scratch: one piece's distinct pixels
+};
+
+/// Ground-truth pixels and the matched share of them, of the steps whose value lies in [lo, hi).
+struct EdgeRecallBin {
+  double lo = 0, hi = 0;
+  std::uint64_t pixels = 0, matched = 0;
+};
+/// The steps binned by one of their values at the given bin edges (NaN values go in no bin).
+enum class EdgeMeasure { NormalSpeed, Length, ParallelGap };
+std::vector<EdgeRecallBin> bin_edge_recall(std::span<const EdgeStep> steps, EdgeMeasure measure, std::span<const double> edges);
+/// The three tables (speed, length, parallel gap) as text, with each bin's share of all pixels.
+std::string edge_recall_tables(std::span<const EdgeStep> steps);
+/// One row per EdgeStep: run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched.
+std::string edge_recall_csv_header();
+std::string edge_recall_csv_rows(const std::string& run, std::span<const EdgeStep> steps);
+
+}  // namespace evldt
