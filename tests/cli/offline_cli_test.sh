@@ -126,7 +126,9 @@ echo "ok: whole-line support $file_support from the CSVs, $in_process_support in
 
 # Recall per true edge: multi-speed's bars move sideways, so their horizontal edges run along their
 # own motion and give no events; the vertical ones cross the sensor at 15 to 500 px/s.
-"$eval" --scene multi-speed --duration-s 0.5 --log-level warn --edge-recall "$work/edges.csv" >"$work/edges.txt"
+"$eval" --scene multi-speed --duration-s 0.5 --log-level warn --edge-recall "$work/edges.csv" --edge-recall-png "$work/edges.png" \
+  >"$work/edges.txt"
+[[ -s "$work/edges.png" && -s "$work/edges-whole.png" ]] || fail "no edge-recall pictures"
 grep -q "recall per true edge, multi-speed whole" "$work/edges.txt" || fail "no edge-recall tables: $(cat "$work/edges.txt")"
 head -1 "$work/edges.csv" | grep -qx "run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched" ||
   fail "edge-recall CSV header: $(head -1 "$work/edges.csv")"

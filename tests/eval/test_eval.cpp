@@ -627,7 +627,7 @@ TEST(EdgeRecall, CountsEachEdgesPixelsAndMatchesWithItsSpeedAndParallelGap) {
     ids = {3, 7};
   };
   StreamEvaluator evaluator(kSensor, {0.01}, truth, std::llround(StreamEvaluator::kHoldPeriods * kGtPeriod));
-  evaluator.keep_edge_recall();
+  evaluator.keep_edge_recall(/*picture_at_us=*/15);
   for (int k = 0; k < kGtSteps; ++k) predict(evaluator, k * kGtPeriod, 1, {moving_line(static_cast<std::size_t>(k))});
   evaluator.finish();
   ASSERT_TRUE(evaluator.edge_recall());
@@ -662,6 +662,31 @@ TEST(EdgeRecall, CountsEachEdgesPixelsAndMatchesWithItsSpeedAndParallelGap) {
   const std::string csv = edge_recall_csv_rows("run", steps);
   EXPECT_NE(csv.find("run,0,3,40.000,,30.000,41,41\n"), std::string::npos) << csv;
   EXPECT_NE(edge_recall_tables(steps).find("speed across itself"), std::string::npos);
+
+  // The picture is of the first step at or after 15 us: both edges, the prediction, the matches.
+  const auto& picture = evaluator.edge_recall()->picture();
+  ASSERT_TRUE(picture);
+  EXPECT_EQ(picture->t_us, 2 * kGtPeriod);
+  EXPECT_EQ(picture->truth.size(), 2u);
+  ASSERT_EQ(picture->predicted.size(), 1u);
+  EXPECT_EQ(picture->predicted[0].q0, moving_line(2).q0);
+  const auto matched_at = [&](int x, int y) { return picture->matched_map[static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)]; };
+  EXPECT_EQ(matched_at(20, 14), 1);  // on the found line (y = 10 + 2 * 2)
+  EXPECT_EQ(matched_at(20, 40), 0);  // on the missed one
+  const auto path = std::filesystem::temp_directory_path() / "evldt_edge_recall_test.png";
+  write_edge_recall_png(path, *evaluator.edge_recall(), "test", 2);
+  const cv::Mat image = cv::imread(path.string());
+  std::filesystem::remove(path);
+  ASSERT_FALSE(image.empty());
+  EXPECT_EQ(image.cols, 2 * kSensor.width);
+  const cv::Vec3b missed = image.at<cv::Vec3b>(image.rows - 2 * kSensor.height + 2 * 40, 2 * 20);
+  EXPECT_GT(missed[2], 200);  // red (BGR)
+  EXPECT_LT(missed[1], 100);
+
+  StreamEvaluator without_picture(kSensor, {0.01}, truth, 15);
+  without_picture.keep_edge_recall();
+  without_picture.finish();
+  EXPECT_THROW(write_edge_recall_png(path, *without_picture.edge_recall(), "none"), std::runtime_error);
 }
 
 }  // namespace

@@ -30,7 +30,7 @@ using namespace evldt;
 
 struct Options {
   std::filesystem::path segments, whole_lines, ground_truth, frames_gt, write_gt, json, pr_png, lifetime_png, tracks_png, overlay,
-      edge_recall;
+      edge_recall, edge_recall_png;
   LsdParams lsd;
   std::string lcm_channel;
   std::string label;  ///< of the --segments row
@@ -316,6 +316,11 @@ void write_run_plots(const Options& options, const StreamEvaluator& evaluator, c
     write_id_timeline_png(run_path(options.tracks_png, report, several_runs), evaluator.tracking().lines(),
                           report.label + fmt::format(" ids over time (IDF1 {})", figure(report.tracking.idf1)));
   }
+  if (!options.edge_recall_png.empty() && evaluator.edge_recall()) {
+    const auto path = run_path(options.edge_recall_png, report, several_runs);
+    write_edge_recall_png(path, *evaluator.edge_recall(), report.label);
+    spdlog::info("wrote {}", path.string());
+  }
 }
 
 // --edge-recall: each run's recall by the true edges' speed, length and nearest parallel edge, and
@@ -353,7 +358,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     }
     return 0;
   }
-  if (!options.edge_recall.empty() && !options.segments.empty()) {
+  if ((!options.edge_recall.empty() || !options.edge_recall_png.empty()) && !options.segments.empty()) {
     spdlog::error("--edge-recall scores the pipeline's run on --scene (without --segments)");
     return 1;
   }
@@ -399,7 +404,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       spdlog::error("give --segments FILE, or --scene NAME to run the pipeline on a built-in scene");
       return 1;
     }
-    if (!options.edge_recall.empty() && !options.frames_gt.empty()) {
+    if ((!options.edge_recall.empty() || !options.edge_recall_png.empty()) && !options.frames_gt.empty()) {
       spdlog::error("--edge-recall needs the scene's exact edges: LSD's lines (--frames-gt) have no ids that last");
       return 1;
     }
@@ -415,9 +420,10 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       const auto started = std::chrono::steady_clock::now();
       last.emplace(scene.sensor, options.tolerances, truth, hold_us);
       StreamEvaluator whole(scene.sensor, options.tolerances, truth, hold_us);
-      if (!options.edge_recall.empty()) {
-        last->keep_edge_recall();
-        whole.keep_edge_recall();
+      if (!options.edge_recall.empty() || !options.edge_recall_png.empty()) {
+        const Timestamp middle = truth.times.empty() ? 0 : truth.times[truth.times.size() / 2];
+        last->keep_edge_recall(middle);
+        whole.keep_edge_recall(middle);
       }
       const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -525,6 +531,9 @@ int main(int argc, char** argv) {
                  "Scene runs: print the recall by the true edges' speed across themselves, length and distance to the "
                  "nearest parallel edge, and write every true edge at every step to this CSV "
                  "(run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched)");
+  app.add_option("--edge-recall-png", options.edge_recall_png,
+                 "Scene runs: a picture of the middle ground-truth step, its true edges green where found and red where "
+                 "missed, the prediction in blue (the whole lines' run in NAME-whole.png)");
   app.add_option("--lifetime-png", options.lifetime_png,
                  "Histogram of segment lifetimes (with --pr-thresholds one file per run, NAME-f<threshold>.png)");
   app.add_option("--tracks-png", options.tracks_png,

@@ -4,10 +4,13 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 
 #include "evldt/eval/line_heatmap.hpp"
+#include "evldt/media/media.hpp"
 
 namespace evldt {
 
@@ -47,7 +50,10 @@ float parallel_gap(const Segment& piece, std::size_t self, std::span<const Segme
 }  // namespace
 
 void EdgeRecall::add_step(Timestamp t, std::span<const Segment> truth, std::span<const std::uint64_t> ids,
-                          std::span<const std::uint8_t> matched_map) {
+                          std::span<const Segment> predicted, std::span<const std::uint8_t> matched_map) {
+  if (picture_at_us_ && !picture_ && t >= *picture_at_us_) {
+    picture_ = Picture{t, {truth.begin(), truth.end()}, {predicted.begin(), predicted.end()}, {matched_map.begin(), matched_map.end()}};
+  }
   std::unordered_map<std::uint64_t, Seen> current;
   const auto width = static_cast<std::uint32_t>(sensor_.width);
   for (std::size_t i = 0; i < truth.size(); ++i) {
@@ -127,6 +133,33 @@ std::string edge_recall_csv_rows(const std::string& run, std::span<const EdgeSte
                        number(s.parallel_gap_px), s.pixels, s.matched);
   }
   return out;
+}
+
+void write_edge_recall_png(const std::filesystem::path& path, const EdgeRecall& recall, const std::string& title, int scale) {
+  const auto& picture = recall.picture();
+  if (!picture) throw std::runtime_error("no step to draw for " + path.string() + ": the run ended before the picture's time");
+  const SensorSize sensor = recall.sensor();
+  constexpr int kBanner = 24;
+  cv::Mat image(sensor.height * scale + kBanner, sensor.width * scale, CV_8UC3, cv::Scalar(255, 255, 255));
+  const auto width = static_cast<std::size_t>(sensor.width);
+  for (const Segment& piece : picture->truth) {
+    for_each_segment_sample(piece, sensor, [&](int x, int y) {
+      const bool matched = picture->matched_map[static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)] != 0;
+      cv::rectangle(image, cv::Rect(x * scale, y * scale + kBanner, scale, scale),
+                    matched ? cv::Scalar(60, 170, 60) : cv::Scalar(40, 40, 220), cv::FILLED);
+    });
+  }
+  const auto at = [&](const Point2& p) {
+    return cv::Point(static_cast<int>(std::lround(p.x() * static_cast<float>(scale))),
+                     static_cast<int>(std::lround(p.y() * static_cast<float>(scale))) + kBanner);
+  };
+  for (const Segment& s : picture->predicted) {
+    if (s.q0.allFinite() && s.q1.allFinite()) cv::line(image, at(s.q0), at(s.q1), cv::Scalar(200, 90, 20), 1, cv::LINE_AA);
+  }
+  cv::putText(image, fmt::format("{} at {:.3f} s: true edges found (green) / missed (red), predicted (blue)", title,
+                                 static_cast<double>(picture->t_us) * 1e-6),
+              cv::Point(4, 17), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  if (!media::write_image(path.string(), image)) throw std::runtime_error("could not write " + path.string());
 }
 
 }  // namespace evldt

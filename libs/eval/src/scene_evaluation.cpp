@@ -91,7 +91,9 @@ StreamEvaluator::StreamEvaluator(SensorSize sensor, std::vector<double> toleranc
   coverage_.ground_truth_steps = ground_truth_.times.size();
 }
 
-void StreamEvaluator::keep_edge_recall() { edge_recall_.emplace(matchers_.front().sensor()); }
+void StreamEvaluator::keep_edge_recall(std::optional<Timestamp> picture_at_us) {
+  edge_recall_.emplace(matchers_.front().sensor(), picture_at_us);
+}
 
 void StreamEvaluator::score_steps_before(Timestamp until) {
   const std::vector<Timestamp>& times = ground_truth_.times;
@@ -110,7 +112,7 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
     tracking_.add_step(t, predicted_ids, predicted, truth_ids_, truth_);
     if (edge_recall_) {
       matchers_.front().matched_ground_truth(matched_map_);
-      edge_recall_->add_step(t, truth_, truth_ids_, matched_map_);
+      edge_recall_->add_step(t, truth_, truth_ids_, predicted, matched_map_);
     }
   }
 }

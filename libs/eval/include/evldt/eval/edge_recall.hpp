@@ -4,6 +4,8 @@
 // across itself), its length, and how close the nearest parallel edge lies (two edges in one block).
 
 #include <cstdint>
+#include <filesystem>
+#include <optional>
 #include <span>
 #include <string>
 #include <unordered_map>
@@ -32,15 +34,29 @@ class EdgeRecall {
  public:
   static constexpr float kParallelDegrees = 10;
 
-  explicit EdgeRecall(SensorSize sensor) : sensor_(sensor) {}
-  /// One scored step: the true pieces and their line ids, and the ground-truth pixels the matcher
-  /// paired (HeatmapMatcher::matched_ground_truth). A pixel two pieces share counts for both.
+  /// picture_at_us: the step at or after this time is kept for a picture (write_edge_recall_png).
+  explicit EdgeRecall(SensorSize sensor, std::optional<Timestamp> picture_at_us = std::nullopt)
+      : sensor_(sensor), picture_at_us_(picture_at_us) {}
+  /// One scored step: the true pieces and their line ids, the prediction scored against them, and
+  /// the ground-truth pixels the matcher paired (HeatmapMatcher::matched_ground_truth). A pixel two
+  /// pieces share counts for both.
   void add_step(Timestamp t, std::span<const Segment> truth, std::span<const std::uint64_t> ids,
-                std::span<const std::uint8_t> matched_map);
+                std::span<const Segment> predicted, std::span<const std::uint8_t> matched_map);
   [[nodiscard]] const std::vector<EdgeStep>& steps() const { return steps_; }
+
+  /// The step kept for a picture.
+  struct Picture {
+    Timestamp t_us = 0;
+    std::vector<Segment> truth, predicted;
+    std::vector<std::uint8_t> matched_map;
+  };
+  [[nodiscard]] const std::optional<Picture>& picture() const { return picture_; }
+  [[nodiscard]] SensorSize sensor() const { return sensor_; }
 
  private:
   SensorSize sensor_;
+  std::optional<Timestamp> picture_at_us_;
+  std::optional<Picture> picture_;
   std::vector<EdgeStep> steps_;
   struct Seen {
     Timestamp t_us;
@@ -63,5 +79,9 @@ std::string edge_recall_tables(std::span<const EdgeStep> steps);
 /// One row per EdgeStep: run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched.
 std::string edge_recall_csv_header();
 std::string edge_recall_csv_rows(const std::string& run, std::span<const EdgeStep> steps);
+/// The kept step drawn `scale` times the sensor's size: true edges' pixels green where matched and
+/// red where missed, the predicted segments in blue over them. Throws std::runtime_error when there
+/// is no picture or it cannot be written.
+void write_edge_recall_png(const std::filesystem::path& path, const EdgeRecall& recall, const std::string& title, int scale = 3);
 
 }  // namespace evldt

@@ -83,7 +83,8 @@ class StreamEvaluator {
   static constexpr std::uint64_t kMaxSeconds = 1'000'000;  ///< of the per-second table: 11.6 days
   [[nodiscard]] Timestamp hold_us() const { return hold_us_; }
   /// Also keep the recall of each true edge at each step, at the first tolerance (before any step).
-  void keep_edge_recall();
+  /// picture_at_us: also keep the step at or after that time for a picture.
+  void keep_edge_recall(std::optional<Timestamp> picture_at_us = std::nullopt);
   /// The recall per edge, when kept.
   [[nodiscard]] const std::optional<EdgeRecall>& edge_recall() const { return edge_recall_; }
   [[nodiscard]] const GroundTruthSteps& ground_truth() const { return ground_truth_; }
