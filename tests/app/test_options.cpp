@@ -34,7 +34,7 @@ TEST(PipelineOptions, EachShippedConfigGivesTheDesignDefaults) {
     int block_size;
     float perturbation;
   };
-  for (const Expect& e : {Expect{"240x180.toml", {240, 180}, 8, 0.8f}, Expect{"346x260.toml", {346, 260}, 10, 1.1f},
+  for (const Expect& e : {Expect{"240x180.toml", {240, 180}, 8, 0.8f}, Expect{"346x260.toml", {346, 260}, 8, 1.1f},
                           Expect{"640x480.toml", {640, 480}, 14, 2.5f}, Expect{"1280x720.toml", {1280, 720}, 14, 2.5f}}) {
     PipelineOptions options;
     ASSERT_EQ(parse({"--config", (kConfigDir / e.file).string()}, options), 0) << e.file;
@@ -44,6 +44,7 @@ TEST(PipelineOptions, EachShippedConfigGivesTheDesignDefaults) {
     EXPECT_EQ(config.lattice.block_size, e.block_size) << e.file;
     EXPECT_FLOAT_EQ(config.track.perturbation_px, e.perturbation) << e.file;
     EXPECT_FLOAT_EQ(config.score.fit_threshold, 0.2f);
+    EXPECT_FLOAT_EQ(config.score.retry_share, 0.15f);
     EXPECT_EQ(config.schedule.track_period_us, 2000);
     EXPECT_EQ(config.schedule.detect_period_us, 4000);
     // Without the file, the same sensor gives the same values.

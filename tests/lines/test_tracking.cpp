@@ -145,6 +145,32 @@ TEST(LineMap, SuppressionProhibitsNearNeighboursForOneDetectionRound) {
   EXPECT_NEAR(found.segment.q1.x(), 15.5f, 1e-3f);
 }
 
+// A refused block is fitted again only once floor(0.15 N) = 4 new active entries came in: a block
+// holding a line one event short of f_th gains that event, and waits for three more.
+TEST(LineDetector, ARefusedBlockIsFittedAgainOnlyOnceItGainedNewActiveEntries) {
+  for (const float retry_share : {0.15f, 0.0f}) {
+    ScarfLattice lattice({64, 48}, 8, 1.0);
+    LineMap lines(kGeometry);
+    ScoreParams params;
+    params.retry_share = retry_share;
+    LineDetector detector(kGeometry, params);
+    for (int y = 20; y < 27; ++y) lattice.insert(15, static_cast<std::uint16_t>(y));  // 7 of 8 px: 7/8 * 7/32 < 0.2
+    EXPECT_EQ(detector.detect(lattice, lines, 10), 0);
+    lattice.insert(15, 27);  // 8 of 8 px: 8/32 = 0.25, a line for a fresh detector
+    LineDetector fresh(kGeometry, params);
+    LineMap fresh_lines(kGeometry);
+    EXPECT_EQ(fresh.detect(lattice, fresh_lines, 20), 1);
+    EXPECT_EQ(detector.detect(lattice, lines, 20), retry_share > 0 ? 0 : 1) << retry_share;
+    if (retry_share == 0) continue;
+    lattice.insert(15, 20);
+    lattice.insert(15, 21);
+    EXPECT_EQ(detector.detect(lattice, lines, 30), 0);  // three new
+    lattice.insert(15, 22);
+    EXPECT_EQ(detector.detect(lattice, lines, 40), 1);  // four
+    EXPECT_NEAR(lines.lines().back().segment.q0.x(), 15.5f, 1e-3f);
+  }
+}
+
 TEST(LineTracker, ReleasesAfterItsPatienceAndWhenPointsVanish) {
   ScarfLattice lattice({64, 48}, 8, 1.0);
   for (int y = 20; y < 28; ++y) lattice.insert(15, static_cast<std::uint16_t>(y));  // 8 points: score 0.25

@@ -41,6 +41,9 @@ const std::vector<Parameter>& table() {
        .help = "Detection: no line where the events beyond both of its ends bend off to one side by this much, at least 2 px "
                "(an arc; 0: off)",
        .field = +[](PipelineConfig& c) -> float& { return c.score.max_bend_ratio; }},
+      {.flag = "detect-retry", .group = kPipeline, .type = Type::Real, .min = 0, .max = 1, .unit = "N",
+       .help = "Detection: a block whose fit failed is fitted again once this share of N new active entries came in (0: at any change)",
+       .field = +[](PipelineConfig& c) -> float& { return c.score.retry_share; }},
       {.flag = "perturbation", .group = kPipeline, .type = Type::Real, .min = 0.01, .max = 20, .unit = "px",
        .help = "Endpoint perturbation dq", .field = +[](PipelineConfig& c) -> float& { return c.track.perturbation_px; }},
       {.flag = "bad-track-patience-us", .group = kPipeline, .type = Type::Integer, .min = 1, .max = kLongestUs, .unit = "us",

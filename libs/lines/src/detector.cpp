@@ -13,7 +13,10 @@ constexpr std::uint64_t kNeverFailed = UINT64_MAX;
 }  // namespace
 
 LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& params, WorkerPool* pool)
-    : geometry_(geometry), params_(params), pool_(pool) {
+    : geometry_(geometry),
+      params_(params),
+      pool_(pool),
+      retry_after_(static_cast<std::uint16_t>(std::clamp(std::floor(params.retry_share * static_cast<float>(geometry.capacity)), 0.0f, 65535.0f))) {
   const int threads = pool ? pool->threads() : 1;
   const float b = static_cast<float>(geometry.block_size);
   workers_.reserve(static_cast<std::size_t>(threads));
@@ -22,6 +25,7 @@ LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& p
     worker.points.reserve(static_cast<std::size_t>(geometry.capacity));
   }
   failed_at_.assign(static_cast<std::size_t>(geometry.block_count()), kNeverFailed);
+  failed_arrivals_.assign(static_cast<std::size_t>(geometry.block_count()), 0);
   found_.resize(static_cast<std::size_t>(geometry.block_count()));
 }
 
@@ -72,8 +76,11 @@ void LineDetector::detect_row(const ScarfLattice& lattice, LineMap& lines, int r
     // clear f_th, so its fit is skipped; the same comparison in floats, so skipping is exact.
     if (static_cast<float>(active) / capacity <= params_.fit_threshold) continue;
     const std::uint64_t version = lattice.version(block);
+    const std::uint16_t arrivals = lattice.active_arrivals(block);
     if (failed_at_[block] == version) continue;
+    if (failed_at_[block] != kNeverFailed && static_cast<std::uint16_t>(arrivals - failed_arrivals_[block]) < retry_after_) continue;
     failed_at_[block] = version;  // until it succeeds below
+    failed_arrivals_[block] = arrivals;
     worker.points.clear();
     worker.points.add(lattice.entries(block), /*include_inactive=*/false);
     const auto line = fit_line(worker.points, params_.fit_iterations);

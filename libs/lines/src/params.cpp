@@ -12,7 +12,7 @@ PipelineConfig default_config_for(SensorSize sensor) {
     float perturbation_px;
   };
   // docs/configuration.md; dq scales with width from the closest row.
-  constexpr std::array<Row, 4> rows{{{240, 8, 0.8f}, {346, 10, 1.1f}, {640, 14, 2.5f}, {1280, 14, 2.5f}}};
+  constexpr std::array<Row, 4> rows{{{240, 8, 0.8f}, {346, 8, 1.1f}, {640, 14, 2.5f}, {1280, 14, 2.5f}}};
   const Row* best = &rows[0];
   for (const Row& row : rows) {
     if (std::abs(row.width - sensor.width) < std::abs(best->width - sensor.width)) best = &row;

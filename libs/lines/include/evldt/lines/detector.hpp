@@ -1,7 +1,10 @@
 #pragma once
 // Line detection (docs/design.md, section 4): per free block, a robust line fit clipped to the block, kept when its
 // fitting score clears the threshold. A block whose entries have not changed since it last failed
-// is skipped: the fit and the score depend on nothing else, so it would fail again.
+// is skipped: the fit and the score depend on nothing else, so it would fail again. Nor is it
+// fitted again before it gained ScoreParams::retry_share of N new active entries: a few new events
+// leave it nearly the same test, and every retry is one more chance for stale or noise events to
+// clear f_th by luck (docs/accuracy.md, recall per true edge).
 
 #include <cstdint>
 #include <vector>
@@ -50,6 +53,8 @@ class LineDetector {
   std::vector<Worker> workers_;
   std::uint64_t versions_of_ = 0;         // the lattice whose block versions failed_at_ holds
   std::vector<std::uint64_t> failed_at_;  // per block: its version at its last failed attempt
+  std::vector<std::uint16_t> failed_arrivals_;  // per block: its ScarfLattice::active_arrivals at that attempt
+  std::uint16_t retry_after_;                    // new active entries before a failed block is fitted again
   std::vector<Found> found_;              // per block
 };
 

@@ -30,6 +30,9 @@ struct ScoreParams {
   /// of b (at least 2 px): a block's line is not detected where the events run on beyond both of its
   /// ends and bend away to one side by this much over the span (an arc: bend_test.hpp). 0: off.
   float max_bend_ratio = 0.1f;
+  /// of N: a block whose fit failed is fitted again only once this share of N new active entries
+  /// came in (floor(share * N); 0: at any change). Chosen on the built-in scenes (docs/accuracy.md).
+  float retry_share = 0.15f;
 };
 
 /// A new detection takes over the id of a line released nearby a moment before, so an id lasts

@@ -103,6 +103,9 @@ class ScarfLattice {
             geometry_.row(block) * geometry_.block_size};
   }
   [[nodiscard]] int active_count(int block) const { return blocks_[block].active; }
+  /// ACTIVE entries written into the block so far, modulo 2^16: the difference of two readings (as
+  /// std::uint16_t) is how many came between them, up to 65535.
+  [[nodiscard]] std::uint16_t active_arrivals(int block) const { return blocks_[block].arrivals; }
   /// When the block last changed (events written, clear), on a clock that advances once per insert
   /// call: equal values mean identical contents, so a reader can skip a block it has already seen
   /// in this state.
@@ -127,6 +130,7 @@ class ScarfLattice {
     std::uint16_t head = 0;    ///< next slot to overwrite
     std::uint16_t filled = 0;  ///< slots in use (reaches N and stays)
     std::uint16_t active = 0;  ///< ACTIVE entries among them
+    std::uint16_t arrivals = 0;  ///< ACTIVE entries written, modulo 2^16
     std::uint64_t version = 0; ///< the change clock when the block last changed
   };
   /// Per pixel column (row): the block column (row) whose active region holds it, and the one on
@@ -199,6 +203,7 @@ class ScarfLattice {
     const auto next = static_cast<std::uint16_t>(state.head + 1);
     state.head = next == rings.capacity ? std::uint16_t{0} : next;
     state.version = rings.version;
+    state.arrivals = static_cast<std::uint16_t>(state.arrivals + (kActive ? 1 : 0));
     rings.blocks[block] = state;
   }
 
