@@ -61,6 +61,18 @@ TEST(ScarfLattice, ActiveInHomeBlockInactiveInThreeQuadrantNeighbours) {
   EXPECT_EQ(blocks_written(17, 25), expected_other);
 }
 
+// Detection's retry gate counts the active entries that came into a block since its last refusal.
+TEST(ScarfLattice, ActiveArrivalsCountTheActiveEntriesWrittenIntoABlock) {
+  ScarfLattice lattice(kSensor, 8, 1.0);
+  const auto g = lattice.geometry();
+  for (int k = 0; k < 100; ++k) lattice.insert(13, 21);  // active in block (1, 2), inactive in three others
+  EXPECT_EQ(lattice.active_arrivals(g.index(1, 2)), 100);  // all of them, past the ring's N = 32
+  EXPECT_EQ(lattice.active_count(g.index(1, 2)), 32);
+  EXPECT_EQ(lattice.active_arrivals(g.index(0, 2)), 0);    // inactive entries do not count
+  for (int k = 0; k < 65536; ++k) lattice.insert(13, 21);  // modulo 2^16
+  EXPECT_EQ(lattice.active_arrivals(g.index(1, 2)), 100);
+}
+
 TEST(ScarfLattice, MarginPixelsAreOnlyInactive) {
   const auto g = LatticeGeometry::make(kSensor, 8, 1.0);
   // Top-left margin corner pixel: inside block (0,0)'s extended region only.
@@ -110,6 +122,7 @@ TEST(ScarfLattice, CopyStateGivesAnIdenticalView) {
 void expect_same_rings(const ScarfLattice& a, const ScarfLattice& b) {
   for (int block = 0; block < a.geometry().block_count(); ++block) {
     ASSERT_EQ(a.active_count(block), b.active_count(block)) << block;
+    ASSERT_EQ(a.active_arrivals(block), b.active_arrivals(block)) << block;
     const auto ea = a.entries(block).entries, eb = b.entries(block).entries;
     ASSERT_EQ(ea.size(), eb.size()) << block;
     for (std::size_t i = 0; i < ea.size(); ++i) ASSERT_EQ(ea[i].bits, eb[i].bits) << block;

@@ -85,6 +85,7 @@ ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool
   columns_ = axis_blocks(sensor.width, block_size, geometry_.blocks_x, 1, 0);
   rows_ = axis_blocks(sensor.height, block_size, geometry_.blocks_y, geometry_.blocks_x, LatticeEntry::kAxisBits);
   blocks_.resize(static_cast<std::size_t>(geometry_.block_count()));
+  arrivals_.resize(static_cast<std::size_t>(geometry_.block_count()));
   entries_.resize(static_cast<std::size_t>(geometry_.block_count()) * geometry_.capacity);
   if (keep_surface) surface_.assign(static_cast<std::size_t>(sensor.width) * sensor.height, 0);
 }
@@ -119,6 +120,8 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
     while (end < count && changed(end)) ++end;
     std::copy(other.blocks_.begin() + static_cast<std::ptrdiff_t>(begin), other.blocks_.begin() + static_cast<std::ptrdiff_t>(end),
               blocks_.begin() + static_cast<std::ptrdiff_t>(begin));
+    std::copy(other.arrivals_.begin() + static_cast<std::ptrdiff_t>(begin), other.arrivals_.begin() + static_cast<std::ptrdiff_t>(end),
+              arrivals_.begin() + static_cast<std::ptrdiff_t>(begin));
     std::copy(other.entries_.begin() + static_cast<std::ptrdiff_t>(begin * capacity),
               other.entries_.begin() + static_cast<std::ptrdiff_t>(end * capacity),
               entries_.begin() + static_cast<std::ptrdiff_t>(begin * capacity));
@@ -130,7 +133,7 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
 }
 
 std::size_t ScarfLattice::memory_bytes() const {
-  return entries_.size() * sizeof(LatticeEntry) + blocks_.size() * sizeof(BlockState) +
+  return entries_.size() * sizeof(LatticeEntry) + blocks_.size() * sizeof(BlockState) + arrivals_.size() * sizeof(std::uint16_t) +
          (columns_.size() + rows_.size()) * sizeof(AxisBlocks) +
          surface_.size() * sizeof(std::uint16_t);
 }
