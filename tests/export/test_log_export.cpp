@@ -10,20 +10,12 @@
 #include "evldt/export/log_export.hpp"
 #include "evldt/segment_list_t.hpp"
 #include "evldt/transport/messages.hpp"
+#include "support/lcm_log_writing.hpp"
 
 namespace evldt {
 namespace {
 
 constexpr Timestamp kEpochCameraUs = 1'700'000'000'000'000;  // November 2023, in microseconds
-
-void write(lcm::LogFile& log, std::int64_t t_us, const std::string& channel, const std::vector<std::uint8_t>& bytes) {
-  lcm::LogEvent event{};
-  event.timestamp = t_us;
-  event.channel = channel;
-  event.datalen = static_cast<std::int32_t>(bytes.size());
-  event.data = const_cast<std::uint8_t*>(bytes.data());
-  ASSERT_EQ(log.writeEvent(&event), 0);
-}
 
 TEST(LogExport, ACameraClockInUnixTimeExportsEveryMessage) {
   const auto dir = std::filesystem::temp_directory_path() / ("evldt_epoch_export_" + std::to_string(::getpid()));
@@ -47,7 +39,7 @@ TEST(LogExport, ACameraClockInUnixTimeExportsEveryMessage) {
       header.utime = 1'765'000'000'000'000 + batch * 10'000;
       std::vector<std::uint8_t> bytes;
       encode_event_batch(header, events, bytes);
-      write(log, header.utime, "EVENTS_CAM0", bytes);
+      test_support::write_log_event(log, header.utime, "EVENTS_CAM0", bytes);
     }
     segment_list_t list{};
     list.utime = 1'765'000'000'300'000;
@@ -69,9 +61,11 @@ TEST(LogExport, ACameraClockInUnixTimeExportsEveryMessage) {
     list.num_segments = 1;
     std::vector<std::uint8_t> bytes(static_cast<std::size_t>(list.getEncodedSize()));
     list.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-    write(log, list.utime, "LINES_CAM0", bytes);
+    test_support::write_log_event(log, list.utime, "LINES_CAM0", bytes);
   }
-  const LogExportCounts counts = export_log_to_mcap(log_path, dir / "epoch.mcap", LogExportOptions{.image_hz = 20});
+  LogExportOptions options;
+  options.image_hz = 20;
+  const LogExportCounts counts = export_log_to_mcap(log_path, dir / "epoch.mcap", options);
   EXPECT_EQ(counts.camera, "cam0");
   EXPECT_EQ(counts.invalid, 0u);
   EXPECT_EQ(counts.segment_lists, 1u);

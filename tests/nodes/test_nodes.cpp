@@ -528,21 +528,31 @@ void publish_column_and_line(lcm::LCM& lcm, Timestamp t0, Timestamp list_t) {
   publish_raw(lcm, "LINES_CAM0", encode(list));
 }
 
-TEST(Nodes, VizTakesACameraClockInUnixTime) {
-  // A live camera's events stamped in Unix microseconds: drawn, and the time shown from the first.
-  lcm::LCM lcm("memq://");
+VizNodeOptions twice_scale_viz_options() {
   VizNodeOptions options;
   options.render_hz = 200;
   options.render.scale = 2;
-  VizNode viz(lcm, options);
-  constexpr Timestamp kEpochCameraUs = 1'700'000'000'000'000;
-  publish_column_and_line(lcm, kEpochCameraUs, kEpochCameraUs + 250'000);
+  return options;
+}
+
+// Runs the viz until it has rendered `frames` frames; the last of them.
+cv::Mat render_frames(VizNode& viz, std::uint64_t frames) {
   cv::Mat last;
   const std::atomic<bool> never{false};
   viz.run(never, [&](const cv::Mat& frame) {
     frame.copyTo(last);
-    return viz.totals().frames < 2;
+    return viz.totals().frames < frames;
   });
+  return last;
+}
+
+TEST(Nodes, VizTakesACameraClockInUnixTime) {
+  // A live camera's events stamped in Unix microseconds: drawn, and the time shown from the first.
+  lcm::LCM lcm("memq://");
+  VizNode viz(lcm, twice_scale_viz_options());
+  constexpr Timestamp kEpochCameraUs = 1'700'000'000'000'000;
+  publish_column_and_line(lcm, kEpochCameraUs, kEpochCameraUs + 250'000);
+  const cv::Mat last = render_frames(viz, 2);
   EXPECT_EQ(viz.totals().segment_lists, 1u);
   EXPECT_EQ(viz.totals().events.invalid_messages, 0u);
   EXPECT_GT(last.at<cv::Vec3b>(2 * 70, 2 * 50)[0], 40);  // the events' column, at twice the scale
@@ -552,10 +562,7 @@ TEST(Nodes, VizTakesACameraClockInUnixTime) {
 
 TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
   lcm::LCM lcm("memq://");
-  VizNodeOptions options;
-  options.render_hz = 200;
-  options.render.scale = 2;
-  VizNode viz(lcm, options);
+  VizNode viz(lcm, twice_scale_viz_options());
 
   publish_column_and_line(lcm, 1000, 0);
   publish_raw(lcm, "LINES_CAM0", {1, 2, 3});  // refused, counted
@@ -570,12 +577,7 @@ TEST(Nodes, VizDrawsEventsSegmentsAndStatus) {
   stats.num_masked_pixels = 0;
   publish_raw(lcm, std::string(kStatsChannel), encode(stats));
 
-  cv::Mat last;
-  const std::atomic<bool> never{false};
-  viz.run(never, [&](const cv::Mat& frame) {
-    frame.copyTo(last);
-    return viz.totals().frames < 3;
-  });
+  const cv::Mat last = render_frames(viz, 3);
   EXPECT_EQ(viz.totals().frames, 3u);
   EXPECT_EQ(viz.totals().segment_lists, 1u);
   EXPECT_EQ(viz.totals().invalid_segment_lists, 1u);

@@ -26,6 +26,7 @@
 #include "evldt/transport/payload_queue.hpp"
 #include "evldt/transport/sensor_lag.hpp"
 #include "evldt/transport/sequence_tracker.hpp"
+#include "support/lcm_log_writing.hpp"
 
 namespace evldt {
 namespace {
@@ -874,15 +875,6 @@ class LcmLogFiles : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  static void write(lcm::LogFile& log, const std::string& channel, const Bytes& bytes, std::int64_t timestamp) {
-    lcm::LogEvent event{};
-    event.timestamp = timestamp;
-    event.channel = channel;
-    event.datalen = static_cast<std::int32_t>(bytes.size());
-    event.data = const_cast<std::uint8_t*>(bytes.data());
-    ASSERT_EQ(log.writeEvent(&event), 0);
-  }
-
   // Three batches of 100 events with junk and another camera interleaved, then two segment lists of
   // the same lattice time (the later one wins) and one of a later time.
   std::filesystem::path write_log() {
@@ -890,17 +882,17 @@ class LcmLogFiles : public ::testing::Test {
     lcm::LogFile log(path.string(), "w");
     EXPECT_TRUE(log.good());
     for (std::int64_t seq = 0; seq < 3; ++seq) {
-      write(log, "EVENTS_CAM0", encode(make_batch(make_events(100, 1000 + seq * 1000, 10), seq)), seq);
-      write(log, "EVENTS_CAM0", Bytes{9, 9, 9}, seq);
-      write(log, "EVENTS_CAM1", encode(make_batch(make_events(7, 0), seq)), seq);
+      test_support::write_log_event(log, seq, "EVENTS_CAM0", encode(make_batch(make_events(100, 1000 + seq * 1000, 10), seq)));
+      test_support::write_log_event(log, seq, "EVENTS_CAM0", Bytes{9, 9, 9});
+      test_support::write_log_event(log, seq, "EVENTS_CAM1", encode(make_batch(make_events(7, 0), seq)));
     }
     segment_list_t list = make_list();
-    write(log, "LINES_CAM0", encode(list), 10);
+    test_support::write_log_event(log, 10, "LINES_CAM0", encode(list));
     list.segments.pop_back();
     list.num_segments = 1;
-    write(log, "LINES_CAM0", encode(list), 11);
+    test_support::write_log_event(log, 11, "LINES_CAM0", encode(list));
     list.t_us = 2000;
-    write(log, "LINES_CAM0", encode(list), 12);
+    test_support::write_log_event(log, 12, "LINES_CAM0", encode(list));
     return path;
   }
 
