@@ -140,6 +140,17 @@ awk -F, '$1 == "multi-speed whole" && $5 != "" { if ($5 < 2) { sp += $7; sm += $
 grep -q "edge-recall scores the pipeline's run" "$work/edges_bad.err" || fail "--edge-recall with --segments: $(cat "$work/edges_bad.err")"
 echo "ok: recall per true edge, still / moving across themselves: $(cat "$work/edges_recall.txt")"
 
+# The overload model: every batch thinned to every 4th event, stored as evldt-lines stores it. It
+# costs recall, not the run: F@1% stays within reach of the whole stream's (0.864 whole, 0.820 thinned).
+"$eval" --scene monitor-hd --duration-s 0.15 --tolerance 0.01 --log-level warn >"$work/whole_stream.txt"
+"$eval" --scene monitor-hd --duration-s 0.15 --tolerance 0.01 --log-level warn --thin 4 >"$work/thinned.txt"
+whole_f=$(awk '$1 == "monitor-hd" && $2 != "whole" { print $5 }' "$work/whole_stream.txt")
+thinned_f=$(awk '$1 == "monitor-hd" && $2 != "whole" { print $5 }' "$work/thinned.txt")
+awk -v w="$whole_f" -v t="$thinned_f" 'BEGIN { exit !(w > 0 && t >= 0.75 && t < w) }' ||
+  fail "--thin 4 must lose some F@1% and keep at least 0.75: whole $whole_f, thinned $thinned_f"
+"$eval" --scene monitor-hd --duration-s 0.15 --thin 0 2>/dev/null && fail "--thin 0 must be refused"
+echo "ok: overload model, F@1% whole stream $whole_f, every 4th event $thinned_f"
+
 # Every ground-truth step counts: an empty prediction is no score, one step of prediction is
 # charged for all the others, and the GT CSV and the scene give the same steps.
 head -1 "$work/p.csv" >"$work/empty.csv"

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
 #include "evldt/scarf/scarf_lattice.hpp"
@@ -127,6 +128,48 @@ void expect_same_rings(const ScarfLattice& a, const ScarfLattice& b) {
     ASSERT_EQ(ea.size(), eb.size()) << block;
     for (std::size_t i = 0; i < ea.size(); ++i) ASSERT_EQ(ea[i].bits, eb[i].bits) << block;
   }
+}
+
+TEST(ScarfLattice, InsertingCopiesEndsAsInsertingEachEventThatManyTimes) {
+  for (const int copies : {2, 3, 4}) {
+    ScarfLattice in_copies(kSensor, 8, 1.0, /*keep_surface=*/true), one_by_one(kSensor, 8, 1.0, /*keep_surface=*/true);
+    std::vector<std::uint16_t> xs, ys;
+    for (int k = 0; k < 700; ++k) {  // enough to wrap every ring (N = 32) several times over
+      xs.push_back(static_cast<std::uint16_t>((k * 37 + k / 7) % 64));
+      ys.push_back(static_cast<std::uint16_t>((k * 11 + k / 5) % 48));
+    }
+    in_copies.insert(xs, ys, copies);
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+      for (int c = 0; c < copies; ++c) one_by_one.insert(xs[i], ys[i]);
+    }
+    expect_same_rings(in_copies, one_by_one);
+    EXPECT_EQ(in_copies.surface(), one_by_one.surface()) << copies;
+  }
+}
+
+// Why a thinned stream is stored in copies (RealtimeEngine::process): its events, kept once, fill a
+// ring at half the pace, so the ring reaches twice as far back in time and still holds an edge that
+// has moved on; stored twice, the ring reaches back as far as the whole stream's.
+TEST(ScarfLattice, AThinnedStreamStoredInCopiesReachesBackAsFarAsTheWholeStream) {
+  const SensorSize sensor{240, 180};
+  // A vertical edge moving right, stopped while it crosses block column 10 (x from 84 to 92).
+  const auto events = testing::sweep_events({Point2(20, 0), Point2(20, 180), Point2(100, 0), 0, 680'000}, sensor);
+  EventBatch every_second;
+  for (std::size_t i = 1; i < events.size(); i += 2) every_second.push_back(events[i]);
+  ScarfLattice whole(sensor, 8, 1.0), once(sensor, 8, 1.0), twice(sensor, 8, 1.0);
+  whole.insert(events);
+  once.insert(every_second.x, every_second.y);
+  twice.insert(every_second.x, every_second.y, 2);
+  // The oldest x a block's ring still holds in row 10: the edge's trail behind it.
+  const auto oldest_x = [](const ScarfLattice& lattice, int block) {
+    const BlockEntries entries = lattice.entries(block);
+    int oldest = 1 << 20;
+    for (const LatticeEntry e : entries.entries) oldest = std::min(oldest, entries.pixel_x(e));
+    return oldest;
+  };
+  const int block = whole.geometry().index(10, 10);
+  EXPECT_EQ(oldest_x(twice, block), oldest_x(whole, block));
+  EXPECT_LT(oldest_x(once, block), oldest_x(whole, block));
 }
 
 TEST(ScarfLattice, IncrementalCopyFollowsEveryChange) {

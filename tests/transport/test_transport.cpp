@@ -754,11 +754,13 @@ TEST(EventBatchReceiver, ThinsBatchesThatQueuedEvenlyKeepingTheirLastEvent) {
   const EventBatch ten = make_events(10, 0);
   ASSERT_TRUE(receiver.receive(batch_at(0, now - 500, ten), out, budget, now));
   EXPECT_FALSE(receiver.thinned());
+  EXPECT_EQ(receiver.stride(), 1);
   EXPECT_EQ(out.size(), 10u);
   // Queued 32 ms: every 4th event, ending with the last (events 1, 5 and 9 of its ten).
   const EventBatch later = make_events(10, 100);
   ASSERT_TRUE(receiver.receive(batch_at(1, now - 32'500, later), out, budget, now));
   EXPECT_TRUE(receiver.thinned());
+  EXPECT_EQ(receiver.stride(), 4);  // what the subscriber stores each kept event as (RealtimeEngine::process)
   EXPECT_FALSE(receiver.shed());
   ASSERT_EQ(out.size(), 3u);
   for (std::size_t k = 0; k < out.size(); ++k) {
@@ -771,6 +773,7 @@ TEST(EventBatchReceiver, ThinsBatchesThatQueuedEvenlyKeepingTheirLastEvent) {
   // Then all of the next, that did not queue.
   ASSERT_TRUE(receiver.receive(batch_at(2, now - 400, make_events(10, 200)), out, budget, now));
   EXPECT_FALSE(receiver.thinned());
+  EXPECT_EQ(receiver.stride(), 1);
   EXPECT_EQ(out.size(), 10u);
   const ReceiverCounts counts = receiver.counts();
   EXPECT_EQ(counts.sequence.received, 3u);

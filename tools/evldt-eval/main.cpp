@@ -38,6 +38,7 @@ struct Options {
   std::vector<double> tolerances{0.01, 0.02};
   std::vector<float> pr_thresholds;
   Timestamp step_us = 10000;
+  int thin = 1;  ///< scene runs: every batch thinned to every thin-th event, stored as evldt-lines would
   Timestamp output_period_us = 0;  ///< of a segment file; 0: its median step spacing
   double histogram_bin_ms = 50;
   bool per_second = false;
@@ -425,7 +426,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
         last->keep_edge_recall(middle);
         whole.keep_edge_recall(middle);
       }
-      const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole);
+      const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole, options.thin);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, result.events, wall);
       for (const auto& [evaluator, label] : {std::pair<const StreamEvaluator*, std::string>{&*last, scene.name},
@@ -517,6 +518,11 @@ int main(int argc, char** argv) {
   app.add_option("--step-us", options.step_us, "With --scene: event time between ground-truth steps (and pipeline outputs)")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{100}, Timestamp{10'000'000}));
+  app.add_option("--thin", options.thin,
+                 "Scene runs: a service past its means: every batch thinned to every K-th event (ending with its last) and\n"
+                 "stored as evldt-lines stores a batch it thinned, each kept event K / 2 times, at least once (1: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
   app.add_option("--output-period-us", options.output_period_us,
                  "Output period of --segments (default: its median step spacing); a predicted step is held for 1.5 periods")
       ->check(CLI::Range(Timestamp{1}, Timestamp{10'000'000}));

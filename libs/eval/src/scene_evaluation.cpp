@@ -9,6 +9,7 @@
 #include <string>
 
 #include "evldt/events/event_validator.hpp"
+#include "evldt/lines/realtime_engine.hpp"
 
 namespace evldt {
 
@@ -224,7 +225,7 @@ StreamEvaluator make_scene_evaluator(const Scene& scene, std::vector<double> tol
 }
 
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
-                              Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines) {
+                              Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines, int thin) {
   EventSimulator simulator(scene, sim);
   EventValidator validator(scene.sensor, 0);
   DeterministicPipeline pipeline(config);
@@ -251,13 +252,22 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
       },
       /*whole_lines=*/whole_lines != nullptr);
   SceneRunResult result;
-  EventBatch batch;
+  EventBatch batch, thinned;
   while (true) {
     batch.clear();
     const bool more = simulator.run_until(simulator.now_us() + step_us, batch);
     result.events += batch.size();
     validator.filter(batch);
-    pipeline.process(batch);
+    if (thin > 1 && !batch.empty()) {
+      // As the receiver decodes a thinned batch: every thin-th event, ending with the last.
+      thinned.clear();
+      for (std::size_t i = (batch.size() - 1) % static_cast<std::size_t>(thin); i < batch.size(); i += static_cast<std::size_t>(thin)) {
+        thinned.push_back(batch[i]);
+      }
+      pipeline.process(thinned, RealtimeEngine::stored_copies(thin));
+    } else {
+      pipeline.process(batch);
+    }
     if (!more) break;
   }
   evaluator.finish();

@@ -52,13 +52,13 @@ void DeterministicPipeline::update_next_due() {
   if (output_period_ > 0) next_due_ = std::min(next_due_, next_output_);
 }
 
-void DeterministicPipeline::process(const EventBatch& batch) {
+void DeterministicPipeline::process(const EventBatch& batch, int copies) {
   if (batch.empty()) return;
   if (filters_.empty()) {
-    process_filtered(batch, batch);  // no copy through filter()
+    process_filtered(batch, batch, copies);  // no copy through filter()
   } else {
     filter(batch, filtered_);
-    process_filtered(batch, filtered_);
+    process_filtered(batch, filtered_, copies);
   }
 }
 
@@ -70,7 +70,7 @@ void DeterministicPipeline::filter(const EventBatch& batch, EventBatch& filtered
   }
 }
 
-void DeterministicPipeline::process_filtered(const EventBatch& batch, const EventBatch& filtered) {
+void DeterministicPipeline::process_filtered(const EventBatch& batch, const EventBatch& filtered, int copies) {
   if (batch.empty()) return;
   // The schedule follows the input's clock: events the filters drop still move event time on.
   if (!started_) {
@@ -82,16 +82,16 @@ void DeterministicPipeline::process_filtered(const EventBatch& batch, const Even
   if (rectifier_) {
     rectifier_->apply(filtered, rectified_);
     counters_.off_rectified = rectifier_->dropped();
-    store(rectified_);
+    store(rectified_, copies);
   } else {
-    store(filtered);
+    store(filtered, copies);
   }
   // Rounds due up to the batch's last event: every stored event is older than them (store() ran
   // each round due at or before a stored event's time before storing it).
   if (batch.t.back() >= next_due_) run_rounds_until(batch.t.back());
 }
 
-void DeterministicPipeline::store(const EventBatch& batch) {
+void DeterministicPipeline::store(const EventBatch& batch, int copies) {
   const std::size_t n = batch.size();
   const Timestamp* ts = batch.t.data();
   const std::uint16_t* xs = batch.x.data();
@@ -102,7 +102,7 @@ void DeterministicPipeline::store(const EventBatch& batch) {
     // The run of events before the next round, stored in one call.
     std::size_t end = i + 1;
     while (end < n && ts[end] < next_due_) ++end;
-    lattice_.insert(std::span(xs + i, end - i), std::span(ys + i, end - i));
+    lattice_.insert(std::span(xs + i, end - i), std::span(ys + i, end - i), copies);
     i = end;
   }
   counters_.events += n;

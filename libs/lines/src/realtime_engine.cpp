@@ -68,7 +68,7 @@ void RealtimeEngine::stop() {
   if (track_thread_.joinable()) track_thread_.join();
 }
 
-void RealtimeEngine::process(const EventBatch& input) {
+void RealtimeEngine::process(const EventBatch& input, int copies) {
   if (input.empty()) return;
   storing_.store(true, std::memory_order_relaxed);
   const EventBatch* stored = &input;
@@ -94,7 +94,7 @@ void RealtimeEngine::process(const EventBatch& input) {
     {
       std::lock_guard lock(lattice_mutex_);
       if (end > begin) {
-        lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin));
+        lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin), copies);
         events_stored_ += end - begin;
         latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
       }

@@ -120,7 +120,7 @@ void LinesIngest::store(std::span<const std::uint8_t> payload) {
                    static_cast<double>(budget_.last_queueing_us()) * 1e-3);
     }
   } else if (accepted && !batch_.empty()) {
-    engine_->process(batch_);
+    engine_->process(batch_, RealtimeEngine::stored_copies(receiver_.stride()));
     if (receiver_.thinned()) {
       engine_->note_overload(batch_.t.back());
       if (std::has_single_bit(receiver_.counts().batches_thinned)) {

@@ -90,10 +90,18 @@ ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool
   if (keep_surface) surface_.assign(static_cast<std::size_t>(sensor.width) * sensor.height, 0);
 }
 
-void ScarfLattice::insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys) {
+void ScarfLattice::insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys, int copies) {
   const Rings rings = begin_change();
   const std::size_t n = std::min(xs.size(), ys.size());
-  if (rings.surface == nullptr) {
+  if (copies > 1) {  // apart, so the common loop keeps its single pushes
+    for (std::size_t i = 0; i < n; ++i) {
+      if (rings.surface == nullptr) {
+        insert_event<false>(rings, xs[i], ys[i], copies);
+      } else {
+        insert_event<true>(rings, xs[i], ys[i], copies);
+      }
+    }
+  } else if (rings.surface == nullptr) {
     for (std::size_t i = 0; i < n; ++i) insert_event<false>(rings, xs[i], ys[i]);
   } else {
     for (std::size_t i = 0; i < n; ++i) insert_event<true>(rings, xs[i], ys[i]);

@@ -22,7 +22,7 @@ bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBat
 
 bool EventBatchReceiver::receive_every(std::span<const std::uint8_t> payload, EventBatch& out, std::size_t stride) {
   shed_ = false;
-  thinned_ = false;
+  stride_ = 1;
   if (const WireError error = decode_event_batch(payload, message_, out, stride); error != WireError::None) {
     out.clear();
     refuse(error == WireError::WrongType ? "not an evldt event_batch_t" : "malformed event_batch_t");
@@ -34,7 +34,7 @@ bool EventBatchReceiver::receive_every(std::span<const std::uint8_t> payload, Ev
   }
   const std::uint64_t clock_resets_before = validator_->drops().clock_resets;
   if (stride > 1) {
-    thinned_ = true;
+    stride_ = static_cast<int>(stride);
     ++batches_thinned_;
     events_shed_ += static_cast<std::uint64_t>(message_.num_events) - out.size();
   }
@@ -55,7 +55,7 @@ bool EventBatchReceiver::receive(std::span<const std::uint8_t> payload, EventBat
   }
   out.clear();
   shed_ = false;
-  thinned_ = false;
+  stride_ = 1;
   if (!admit()) return false;
   shed_ = true;
   shed_until_us_ = last_event_us;

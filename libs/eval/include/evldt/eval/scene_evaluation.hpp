@@ -144,9 +144,12 @@ struct SceneRunResult {
 /// it on the scene's ground-truth steps (scene_ground_truth_steps) with a hold of
 /// kHoldPeriods * step_us. `evaluator` must have been made for those steps; so must `whole_lines`,
 /// which, when given, scores the whole lines (WholeLineStage, config.whole_lines) of each output
-/// and measures their support by the segments (WholeLineSupport's defaults).
+/// and measures their support by the segments (WholeLineSupport's defaults). `thin` > 1 models a
+/// service past its means: every batch is thinned to every thin-th event, ending with its last, and
+/// stored as evldt-lines stores a batch it thinned (RealtimeEngine::stored_copies).
 SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, const PipelineConfig& config,
-                              Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines = nullptr);
+                              Timestamp step_us, StreamEvaluator& evaluator, StreamEvaluator* whole_lines = nullptr,
+                              int thin = 1);
 
 /// One ground truth's steps scored as the prediction against another's (LSD on frames against the
 /// exact lines: how good the imitation is), each predicted step held for kHoldPeriods of their

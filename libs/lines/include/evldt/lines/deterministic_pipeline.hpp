@@ -51,14 +51,15 @@ class DeterministicPipeline {
   /// Feeds on-sensor events in time order (an EventValidator upstream guarantees both) through the
   /// filters into storage. A round due at time T sees exactly the stored events with t < T. After a
   /// clock reset upstream, the schedule begins again at the first batch more than kClockStepBackUs
-  /// behind it.
-  void process(const EventBatch& batch);
+  /// behind it. `copies`: each event is stored that many times (a thinned batch, as
+  /// RealtimeEngine::stored_copies says).
+  void process(const EventBatch& batch, int copies = 1);
   /// process() in two stages, the first of which may run on another thread, a few batches ahead:
   /// filter() runs the noise filters alone (the only state it touches), process_filtered() stores
   /// what passed and runs the rounds, with `batch` as given to filter() (its times move the schedule
   /// on). Called in the same order, they give process()'s output.
   void filter(const EventBatch& batch, EventBatch& filtered);
-  void process_filtered(const EventBatch& batch, const EventBatch& filtered);
+  void process_filtered(const EventBatch& batch, const EventBatch& filtered, int copies = 1);
 
   [[nodiscard]] const LineMap& lines() const { return lines_; }
   [[nodiscard]] LineMap& lines() { return lines_; }
@@ -71,7 +72,7 @@ class DeterministicPipeline {
   [[nodiscard]] const WholeLineStage* whole_lines() const { return whole_lines_ ? &*whole_lines_ : nullptr; }
 
  private:
-  void store(const EventBatch& batch);
+  void store(const EventBatch& batch, int copies);
   void start(Timestamp t0);
   void run_rounds_until(Timestamp t);  // every round due at a time <= t
   void skip_gap(Timestamp t);

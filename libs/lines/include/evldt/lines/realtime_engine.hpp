@@ -50,8 +50,17 @@ class RealtimeEngine {
   void start();
   void stop();  ///< joins the loops; idempotent
 
-  /// Filters and stores on-sensor, time-ordered events (from one producer thread).
-  void process(const EventBatch& batch);
+  /// Filters and stores on-sensor, time-ordered events (from one producer thread), each `copies`
+  /// times (a thinned batch: stored_copies()).
+  void process(const EventBatch& batch, int copies = 1);
+  /// How many times each event of a batch thinned to every stride-th is stored: stride / 2, at least
+  /// once. A block's ring then fills at half the pace of the whole stream at any stride, so it never
+  /// reaches back more than twice the time it would unthinned. Kept once, every 4th event made the
+  /// rings reach back four times as far, past edges that had moved on; stored 4 times, the rings
+  /// held a quarter of the distinct events, too few on sparse and noisy scenes. Chosen on the model
+  /// of `evldt-eval --thin` over five scenes (docs/realtime.md): every 2nd event once and every 4th
+  /// twice gave the best mean F@1%.
+  static int stored_copies(int stride) { return stride / 2 > 1 ? stride / 2 : 1; }
   /// Events up to `until_us` were shed unstored (over the latency budget): event time still moves on.
   void shed(Timestamp until_us);
   /// The service is past its means at event time `at_us` (it stored a batch thinned, or shed one):

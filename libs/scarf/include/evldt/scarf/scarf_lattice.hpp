@@ -91,8 +91,12 @@ class ScarfLattice {
       insert_event<true>(rings, x, y);
     }
   }
-  /// Stores the on-sensor events (xs[i], ys[i]) in order; the spans have the same length.
-  void insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys);
+  /// Stores the on-sensor events (xs[i], ys[i]) in order; the spans have the same length. With
+  /// `copies` > 1 each event is stored that many times, as that many inserts of it would (the rings
+  /// end the same): the events of a stream thinned to every k-th, stored k times each, fill a
+  /// block's ring at the pace of the whole stream, so the ring spans the time it would unthinned and
+  /// holds no older edges (RealtimeEngine::process).
+  void insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys, int copies = 1);
   void insert(const EventBatch& batch) { insert(batch.x, batch.y); }
 
   [[nodiscard]] const LatticeGeometry& geometry() const { return geometry_; }
@@ -168,42 +172,48 @@ class ScarfLattice {
             static_cast<std::uint16_t>(geometry_.capacity), change_clock_};
   }
 
+  /// Pushes the event, `copies` times, into each block that holds it: an event's blocks are
+  /// distinct, so pushing its copies block by block ends as inserting it `copies` times over.
   template <bool kSurface>
-  static void insert_event(const Rings& rings, std::uint16_t x, std::uint16_t y) {
+  static void insert_event(const Rings& rings, std::uint16_t x, std::uint16_t y, int copies = 1) {
     const AxisBlocks column = rings.columns[x];
     const AxisBlocks row = rings.rows[y];
-    if ((column.home | row.home) >= 0) push<kSurface, true>(rings, row.home + column.home, column.home_bits | row.home_bits, x, y);
-    if ((column.side | row.home) >= 0) push<kSurface, false>(rings, row.home + column.side, column.side_bits | row.home_bits, x, y);
-    if ((column.home | row.side) >= 0) push<kSurface, false>(rings, row.side + column.home, column.home_bits | row.side_bits, x, y);
-    if ((column.side | row.side) >= 0) push<kSurface, false>(rings, row.side + column.side, column.side_bits | row.side_bits, x, y);
+    if ((column.home | row.home) >= 0) push<kSurface, true>(rings, row.home + column.home, column.home_bits | row.home_bits, x, y, copies);
+    if ((column.side | row.home) >= 0) push<kSurface, false>(rings, row.home + column.side, column.side_bits | row.home_bits, x, y, copies);
+    if ((column.home | row.side) >= 0) push<kSurface, false>(rings, row.side + column.home, column.home_bits | row.side_bits, x, y, copies);
+    if ((column.side | row.side) >= 0) push<kSurface, false>(rings, row.side + column.side, column.side_bits | row.side_bits, x, y, copies);
   }
 
   // Branch-free bookkeeping: whether the overwritten entry was active is data (about a third of
-  // entries are), and a branch on it mispredicts.
+  // entries are), and a branch on it mispredicts. The block's state stays in registers over the copies.
   template <bool kSurface, bool kActive>
-  static void push(const Rings& rings, std::int32_t block, std::uint16_t place_bits, std::uint16_t x, std::uint16_t y) {
+  static void push(const Rings& rings, std::int32_t block, std::uint16_t place_bits, std::uint16_t x, std::uint16_t y, int copies) {
     BlockState state = rings.blocks[block];
-    LatticeEntry& slot = rings.entries[static_cast<std::size_t>(block) * rings.capacity + state.head];
-    const auto full = static_cast<std::uint16_t>(state.filled == rings.capacity);
-    const auto evicted_active = static_cast<std::uint16_t>(full & (slot.bits >> 15));
-    if constexpr (kSurface) {
-      if (evicted_active) {
-        const std::size_t ex = static_cast<std::size_t>(block % rings.blocks_x * rings.block_size + slot.dx());
-        const std::size_t ey = static_cast<std::size_t>(block / rings.blocks_x * rings.block_size + slot.dy());
-        --rings.surface[ey * rings.width + ex];
+    LatticeEntry* const ring = rings.entries + static_cast<std::size_t>(block) * rings.capacity;
+    const LatticeEntry entry{static_cast<std::uint16_t>(kActive ? place_bits | LatticeEntry::kActiveBit : place_bits)};
+    for (int c = 0; c < copies; ++c) {
+      LatticeEntry& slot = ring[state.head];
+      const auto full = static_cast<std::uint16_t>(state.filled == rings.capacity);
+      const auto evicted_active = static_cast<std::uint16_t>(full & (slot.bits >> 15));
+      if constexpr (kSurface) {
+        if (evicted_active) {
+          const std::size_t ex = static_cast<std::size_t>(block % rings.blocks_x * rings.block_size + slot.dx());
+          const std::size_t ey = static_cast<std::size_t>(block / rings.blocks_x * rings.block_size + slot.dy());
+          --rings.surface[ey * rings.width + ex];
+        }
+        if (kActive) ++rings.surface[static_cast<std::size_t>(y) * rings.width + x];
+      } else {
+        (void)x;
+        (void)y;
       }
-      if (kActive) ++rings.surface[static_cast<std::size_t>(y) * rings.width + x];
-    } else {
-      (void)x;
-      (void)y;
+      state.filled = static_cast<std::uint16_t>(state.filled + 1 - full);
+      state.active = static_cast<std::uint16_t>(state.active + (kActive ? 1 : 0) - evicted_active);
+      slot = entry;
+      const auto next = static_cast<std::uint16_t>(state.head + 1);
+      state.head = next == rings.capacity ? std::uint16_t{0} : next;
     }
-    state.filled = static_cast<std::uint16_t>(state.filled + 1 - full);
-    state.active = static_cast<std::uint16_t>(state.active + (kActive ? 1 : 0) - evicted_active);
-    slot = {static_cast<std::uint16_t>(kActive ? place_bits | LatticeEntry::kActiveBit : place_bits)};
-    const auto next = static_cast<std::uint16_t>(state.head + 1);
-    state.head = next == rings.capacity ? std::uint16_t{0} : next;
     state.version = rings.version;
-    if constexpr (kActive) ++rings.arrivals[block];
+    if constexpr (kActive) rings.arrivals[block] = static_cast<std::uint16_t>(rings.arrivals[block] + copies);
     rings.blocks[block] = state;
   }
 

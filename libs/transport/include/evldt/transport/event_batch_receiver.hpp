@@ -53,7 +53,9 @@ class EventBatchReceiver {
   [[nodiscard]] bool shed() const { return shed_; }
   [[nodiscard]] Timestamp shed_until_us() const { return shed_until_us_; }
   /// True if only a share of the last accepted batch's events was decoded (it had queued).
-  [[nodiscard]] bool thinned() const { return thinned_; }
+  [[nodiscard]] bool thinned() const { return stride_ > 1; }
+  /// Of the last accepted batch, every stride()-th event was decoded (1: all of them).
+  [[nodiscard]] int stride() const { return stride_; }
   [[nodiscard]] ReceiverCounts counts() const;
 
  private:
@@ -72,7 +74,7 @@ class EventBatchReceiver {
   event_batch_t message_;
   bool restarted_ = false;
   bool shed_ = false;
-  bool thinned_ = false;
+  int stride_ = 1;
   Timestamp shed_until_us_ = 0;
   std::uint64_t batches_shed_ = 0, batches_thinned_ = 0, events_shed_ = 0;
 };
