@@ -93,9 +93,8 @@ class ScarfLattice {
   }
   /// Stores the on-sensor events (xs[i], ys[i]) in order; the spans have the same length. With
   /// `copies` > 1 each event is stored that many times, as that many inserts of it would (the rings
-  /// end the same): the events of a stream thinned to every k-th, stored k times each, fill a
-  /// block's ring at the pace of the whole stream, so the ring spans the time it would unthinned and
-  /// holds no older edges (RealtimeEngine::process).
+  /// end the same; below 2, once): the events of a thinned stream, stored in copies, fill a block's
+  /// ring faster, so it reaches back less far in time (RealtimeEngine::stored_copies).
   void insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys, int copies = 1);
   void insert(const EventBatch& batch) { insert(batch.x, batch.y); }
 
