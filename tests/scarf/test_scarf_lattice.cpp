@@ -147,9 +147,9 @@ TEST(ScarfLattice, InsertingCopiesEndsAsInsertingEachEventThatManyTimes) {
   }
 }
 
-// Why a thinned stream is stored in copies (RealtimeEngine::process): its events, kept once, fill a
-// ring at half the pace, so the ring reaches twice as far back in time and still holds an edge that
-// has moved on; stored twice, the ring reaches back as far as the whole stream's.
+// What copies do for a thinned stream (the service's rule: RealtimeEngine::stored_copies): every 2nd
+// event, kept once, fills a ring at half the pace, so the ring reaches twice as far back in time and
+// still holds an edge that has moved on; stored twice, it reaches back as far as the whole stream's.
 TEST(ScarfLattice, AThinnedStreamStoredInCopiesReachesBackAsFarAsTheWholeStream) {
   const SensorSize sensor{240, 180};
   // A vertical edge moving right, stopped while it crosses block column 10 (x from 84 to 92).
