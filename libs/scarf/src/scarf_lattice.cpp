@@ -93,13 +93,11 @@ ScarfLattice::ScarfLattice(SensorSize sensor, int block_size, double alpha, bool
 void ScarfLattice::insert(std::span<const std::uint16_t> xs, std::span<const std::uint16_t> ys, int copies) {
   const Rings rings = begin_change();
   const std::size_t n = std::min(xs.size(), ys.size());
-  if (copies > 1) {  // apart, so the common loop keeps its single pushes
-    for (std::size_t i = 0; i < n; ++i) {
-      if (rings.surface == nullptr) {
-        insert_event<false>(rings, xs[i], ys[i], copies);
-      } else {
-        insert_event<true>(rings, xs[i], ys[i], copies);
-      }
+  if (copies > 1) {  // apart, so the common loops keep their single pushes
+    if (rings.surface == nullptr) {
+      for (std::size_t i = 0; i < n; ++i) insert_event<false>(rings, xs[i], ys[i], copies);
+    } else {
+      for (std::size_t i = 0; i < n; ++i) insert_event<true>(rings, xs[i], ys[i], copies);
     }
   } else if (rings.surface == nullptr) {
     for (std::size_t i = 0; i < n; ++i) insert_event<false>(rings, xs[i], ys[i]);
