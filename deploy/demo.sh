@@ -19,5 +19,5 @@ eval_tool=build/release/tools/evldt-eval/evldt-eval
 "$eval_tool" --segments "$out/run.lcmlog" --lcm-channel LINES_CAM0 --label segments --scene "$scene" \
   --json "$out/accuracy-segments.json" --lifetime-png "$out/lifetimes-segments.png" --log-level warn
 "$eval_tool" --segments "$out/run.lcmlog" --lcm-channel WHOLE_LINES_CAM0 --label "whole lines" --scene "$scene" \
-  --json "$out/accuracy-whole-lines.json" --lifetime-png "$out/lifetimes-whole-lines.png" --log-level warn | tail -n 1
+  --json "$out/accuracy-whole-lines.json" --lifetime-png "$out/lifetimes-whole-lines.png" --log-level warn | tail -n +2
 echo "  (also in $out: accuracy-*.json, lifetimes-*.png; offline and deterministic: tools/evldt-offline --scene $scene)"

@@ -230,5 +230,109 @@ TEST(StreamEvaluatorTracking, ScoresTheHeldPredictionAtEveryGroundTruthStep) {
   EXPECT_EQ(evaluator.tracking().lines().at(0).owners.size(), 4u);
 }
 
+// ---- why ids switch, and what identity costs -----------------------------------------------------------
+
+TEST(TrackingEvaluatorCauses, EachSwitchIsCountedUnderWhatBecameOfTheOldId) {
+  const Segment other_line = horizontal(80, 10, 110);
+  const std::vector<std::uint64_t> both = {5, 6};
+  const std::vector<Segment> lines = {kLine, other_line};
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
+  Timestamp t = 0;
+  // Id 1 stands for line 5, then moves to line 6 while id 2 takes line 5: "to another edge".
+  step(evaluator, t++, {1}, {kLine}, both, lines);
+  step(evaluator, t++, {1, 2}, {other_line, kLine}, both, lines);
+  // Id 2 is not published for a step (id 3 stands in) and comes back: "returned" (and back to 2).
+  step(evaluator, t++, {3}, {kLine}, both, lines);
+  step(evaluator, t++, {2}, {kLine}, both, lines);
+  // Id 2 drifts off every line while id 4 covers line 5: "off the edge".
+  step(evaluator, t++, {2, 4}, {horizontal(50, 10, 110), kLine}, both, lines);
+  // Id 4 ends; after a step with nothing on the line, id 5 is born there: "detected again", after a gap.
+  step(evaluator, t++, {}, {}, both, lines);
+  step(evaluator, t++, {5, 6}, {kLine, other_line}, both, lines);
+  // Id 5 ends; id 6, published before, takes the line over: "taken over".
+  step(evaluator, t++, {6}, {horizontal(20, 10, 110)}, both, lines);
+  const TrackingSummary s = evaluator.summary();
+  const IdSwitchCauses& c = s.switch_causes;
+  EXPECT_EQ(c.to_other_edge, 1u);
+  EXPECT_EQ(c.returned, 1u);
+  EXPECT_EQ(c.off_edge, 1u);
+  // Also line 6: id 1 left it at step 2, and id 6 found it again at step 6, after a gap.
+  EXPECT_EQ(c.redetected, 2u);
+  EXPECT_EQ(c.after_gap, 2u);
+  // Also 3 -> 2 at step 3: id 3 ended, and 2 was published before it.
+  EXPECT_EQ(c.taken_over, 2u);
+  EXPECT_EQ(s.id_switches, 7u);
+}
+
+TEST(TrackingEvaluatorCauses, LengthMatchedUnderAnotherIdIsWhatOneIdPerLineWouldRecover) {
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
+  for (Timestamp t = 0; t < 10; ++t) step(evaluator, t, {1, 2}, {horizontal(20, 10, 60), horizontal(20, 60, 110)});
+  const TrackingSummary s = evaluator.summary();
+  EXPECT_NEAR(s.unassigned_matched_px, 500.0, 1e-6);
+  EXPECT_NEAR(2 * (s.id_true_positive_px + s.unassigned_matched_px) / (s.predicted_px + s.ground_truth_px), 1.0, 1e-9);
+}
+
+// ---- motion ---------------------------------------------------------------------------------------
+
+TEST(TrackingEvaluatorVelocity, ComparesEachMatchAlongTheTrueLinesNormal) {
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
+  const std::vector<std::uint64_t> truth_ids = {5};
+  const std::vector<Segment> truth = {kLine};  // drawn left to right: its normal points down the image
+  const std::vector<float> truth_velocity = {100.0f};
+  const std::vector<std::uint64_t> ids = {1};
+  // Drawn the other way round, so its own normal points up: -90 along it is +90 along the line's.
+  const std::vector<Segment> reversed = {horizontal(20, 110, 10)};
+  for (const float velocity : {-90.0f, -130.0f, -100.0f}) {
+    const std::vector<float> predicted_velocity = {velocity};
+    evaluator.add_step(0, ids, reversed, truth_ids, truth, predicted_velocity, truth_velocity);
+  }
+  // Without velocities a step adds nothing to them.
+  evaluator.add_step(1, ids, reversed, truth_ids, truth);
+  const TrackingSummary s = evaluator.summary();
+  EXPECT_EQ(s.velocity_pairs, 3u);
+  EXPECT_NEAR(s.velocity_error_median, 10.0, 1e-4);  // errors 10, 30, 0
+  EXPECT_NEAR(s.velocity_relative_median, 0.1, 1e-6);
+  const std::vector<float> two = {1.0f, 2.0f};
+  EXPECT_THROW(evaluator.add_step(2, ids, reversed, truth_ids, truth, two, truth_velocity), std::invalid_argument);
+}
+
+TEST(TrackingEvaluatorVelocity, SlowTrueLinesAreLeftOutOfTheRelativeErrorAndNoPairsIsUndefined) {
+  TrackingEvaluator evaluator(kTrackSensor, kTolerance);
+  EXPECT_TRUE(std::isnan(evaluator.summary().velocity_error_median));
+  const std::vector<std::uint64_t> ids = {1}, truth_ids = {5};
+  const std::vector<Segment> on_line = {kLine};
+  const std::vector<float> predicted = {3.0f}, slow = {static_cast<float>(kMinRelativeSpeed / 2)};
+  evaluator.add_step(0, ids, on_line, truth_ids, on_line, predicted, slow);
+  const TrackingSummary s = evaluator.summary();
+  EXPECT_EQ(s.velocity_pairs, 1u);
+  EXPECT_NEAR(s.velocity_error_median, 2.0, 1e-6);
+  EXPECT_TRUE(std::isnan(s.velocity_relative_median));
+}
+
+TEST(StreamEvaluatorVelocity, TheTrueVelocityIsTheCentralDifferenceOfTheLinesPlace) {
+  // The line moves down 1 px per 10 ms step (100 px/s along its normal) and turns slightly.
+  GroundTruthSteps truth;
+  truth.times = {0, 10'000, 20'000, 30'000};
+  truth.segments_at = [](std::size_t index, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    const auto k = static_cast<float>(index);
+    segments.assign(1, Segment{Point2(10, 20 + k), Point2(110, 20 + k + 0.01f * k)});
+    ids.assign(1, 5);
+  };
+  StreamEvaluator evaluator(SensorSize{200, 150}, {0.01}, truth, 15'000);
+  const std::vector<std::uint64_t> ids = {3};
+  for (std::size_t i = 0; i < truth.times.size(); ++i) {
+    std::vector<Segment> segments;
+    std::vector<std::uint64_t> truth_ids;
+    truth.segments_at(i, segments, truth_ids);
+    const std::vector<float> velocity = {100.0f};
+    evaluator.add_prediction(truth.times[i], ids, segments, velocity);
+  }
+  evaluator.finish();
+  const TrackingSummary s = evaluator.tracking().summary();
+  EXPECT_EQ(s.velocity_pairs, 4u);
+  EXPECT_LT(s.velocity_error_median, 1.0);
+  EXPECT_LT(s.velocity_relative_median, 0.01);
+}
+
 }  // namespace
 }  // namespace evldt

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -285,6 +286,57 @@ TEST(WholeLineTracker, ALineLostForAMomentComesBackUnderItsIdButNotAfterKeepId) 
   tracker.update(200'001, pieces_along(21, 5, 37, 21));
   ASSERT_EQ(tracker.lines().size(), 1u);
   EXPECT_NE(tracker.lines()[0].id, id);
+}
+
+/// pieces_along, every segment moving across itself at `velocity` px/s (down the image for
+/// positive: the pieces run left to right) and known to within `std`.
+std::vector<TrackedLine> moving_pieces(float y, float x0, float x1, std::uint64_t first_id, float velocity, float std = 20) {
+  std::vector<TrackedLine> pieces = pieces_along(y, x0, x1, first_id);
+  for (TrackedLine& piece : pieces) {
+    piece.normal_velocity = velocity;
+    piece.normal_velocity_std = std;
+  }
+  return pieces;
+}
+
+// three-lines-fast: a bar's edge moves 9 px between two steps, as far as the loose bounds reach; its
+// block segments are detected anew under new ids at every step.
+TEST(WholeLineTracker, ALineFollowsItsEdgeWhereItsMotionTakesIt) {
+  const auto run = [](float velocity) {
+    WholeLineTracker tracker(kBlock);
+    std::vector<std::uint64_t> ids;
+    for (int k = 0; k < 5; ++k) {
+      const float y = 20 + 10.0f * static_cast<float>(k);  // 1000 px/s, steps of 10 ms
+      tracker.update(10'000 * k, moving_pieces(y, 4, 36, 100 * static_cast<std::uint64_t>(k + 1), velocity));
+      if (tracker.lines().size() != 1) return std::vector<std::uint64_t>{};
+      ids.push_back(tracker.lines()[0].id);
+    }
+    return ids;
+  };
+  const std::vector<std::uint64_t> moving = run(1000);
+  ASSERT_EQ(moving.size(), 5u);
+  EXPECT_EQ(std::count(moving.begin(), moving.end(), moving[0]), 5);
+  // Without the motion the line waits where its edge was and a new line takes the edge.
+  const std::vector<std::uint64_t> still = run(0);
+  ASSERT_EQ(still.size(), 5u);
+  EXPECT_NE(still.back(), still.front());
+}
+
+TEST(WholeLineTracker, ALinesVelocityIsItsSegmentsWeightedByHowWellEachIsKnown) {
+  WholeLineTracker tracker(kBlock);
+  // Two well-known pieces at 100 px/s, two poorly known ones at 300; the line runs right to left, so
+  // its normal points up the image and its velocity is negative.
+  std::vector<TrackedLine> pieces = moving_pieces(20, 4, 20, 1, 100, 10) + moving_pieces(20, 20, 36, 3, 300, 1000);
+  for (TrackedLine& piece : pieces) std::swap(piece.segment.q0, piece.segment.q1);
+  for (TrackedLine& piece : pieces) piece.normal_velocity = -piece.normal_velocity;
+  tracker.update(0, pieces);
+  ASSERT_EQ(tracker.lines().size(), 1u);
+  const WholeLine& line = tracker.lines()[0];
+  const float sign = line.segment.q1.x() > line.segment.q0.x() ? 1.0f : -1.0f;  // down the image for a line to the right
+  EXPECT_NEAR(sign * line.normal_velocity, 100.0f, 1.0f);
+  // About the deviation of the mean of the two good ones, widened by the disagreement.
+  EXPECT_GT(line.normal_velocity_std, 10.0f / std::sqrt(2.0f));
+  EXPECT_LT(line.normal_velocity_std, 20.0f);
 }
 
 // boxes-6dof (motion seed 18, 7.78 s): a line that had shrunk to one short segment waited; its old

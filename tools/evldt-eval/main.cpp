@@ -163,7 +163,8 @@ void print_table(const std::vector<Report>& reports, const Options& options) {
     const std::string at = fmt::format("@{:g}%", tol * 100);  // 1%, 0.2%
     std::printf("  %6s  %6s  %6s", ("P" + at).c_str(), ("R" + at).c_str(), ("F" + at).c_str());
   }
-  std::printf("  segs/step  gt/step  gt_steps  no_pred  ids  life_mean_ms life_max_ms  cover  ids/gt  id_sw   IDF1\n");
+  std::printf("  segs/step  gt/step  gt_steps  no_pred  ids  life_mean_ms life_max_ms  cover  ids/gt  id_sw   IDF1"
+              "  vel_err_med  vel_rel_med\n");
   for (const Report& r : reports) {
     if (r.threshold) {
       std::printf("%-24s %6.3f", r.label.c_str(), static_cast<double>(*r.threshold));
@@ -171,12 +172,30 @@ void print_table(const std::vector<Report>& reports, const Options& options) {
       std::printf("%-24s %6s", r.label.c_str(), "-");
     }
     for (const Prf& p : r.summed) std::printf("  %6s  %6s  %6s", figure(p.precision).c_str(), figure(p.recall).c_str(), figure(p.f).c_str());
-    std::printf("  %9.1f  %7.1f  %8llu  %7llu  %4llu  %11.1f %11.1f  %5s  %6s  %5llu  %5s\n", r.mean_predicted,
+    std::printf("  %9.1f  %7.1f  %8llu  %7llu  %4llu  %11.1f %11.1f  %5s  %6s  %5llu  %5s  %11s  %11s\n", r.mean_predicted,
                 r.mean_ground_truth, static_cast<unsigned long long>(r.coverage.ground_truth_steps),
                 static_cast<unsigned long long>(r.coverage.steps_without_prediction),
                 static_cast<unsigned long long>(r.lifetime.count), r.lifetime.mean_ms, r.lifetime.max_ms,
                 figure(r.tracking.coverage).c_str(), figure(r.tracking.ids_per_line, 1).c_str(),
-                static_cast<unsigned long long>(r.tracking.id_switches), figure(r.tracking.idf1).c_str());
+                static_cast<unsigned long long>(r.tracking.id_switches), figure(r.tracking.idf1).c_str(),
+                figure(r.tracking.velocity_error_median, 1).c_str(), figure(r.tracking.velocity_relative_median).c_str());
+  }
+}
+
+// Why ids changed, and what identity cost in length: a line per run that had switches.
+void print_switch_causes(const std::vector<Report>& reports) {
+  for (const Report& r : reports) {
+    const TrackingSummary& t = r.tracking;
+    if (t.id_switches == 0) continue;
+    const IdSwitchCauses& c = t.switch_causes;
+    std::printf("id switches of %s: %llu to another edge, %llu off the edge, %llu returned later, %llu detected again, "
+                "%llu taken over (%llu after a gap); %.0f px matched under another id than the line's, IDF1 with one id per "
+                "line %s\n",
+                r.label.c_str(), static_cast<unsigned long long>(c.to_other_edge), static_cast<unsigned long long>(c.off_edge),
+                static_cast<unsigned long long>(c.returned), static_cast<unsigned long long>(c.redetected),
+                static_cast<unsigned long long>(c.taken_over), static_cast<unsigned long long>(c.after_gap),
+                t.unassigned_matched_px,
+                figure(2 * (t.id_true_positive_px + t.unassigned_matched_px) / (t.predicted_px + t.ground_truth_px)).c_str());
   }
 }
 
@@ -286,6 +305,13 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
     json.key("lines_never_matched").value(t.lines_never_matched).key("coverage").value(t.coverage);
     json.key("ids_per_line").value(t.ids_per_line).key("id_switches").value(t.id_switches);
     json.key("id_precision").value(t.id_precision).key("id_recall").value(t.id_recall).key("idf1").value(t.idf1);
+    json.key("unassigned_matched_px").value(t.unassigned_matched_px);
+    json.key("velocity_pairs").value(t.velocity_pairs).key("vel_err_med").value(t.velocity_error_median);
+    json.key("vel_rel_med").value(t.velocity_relative_median);
+    const IdSwitchCauses& c = t.switch_causes;
+    json.key("id_switch_causes").begin_object().key("to_other_edge").value(c.to_other_edge).key("off_edge").value(c.off_edge);
+    json.key("returned").value(c.returned).key("redetected").value(c.redetected).key("taken_over").value(c.taken_over);
+    json.key("after_gap").value(c.after_gap).end_object();
     json.end_object();
     if (r.support) write_support_json(json, *r.support);
     json.end_object();
@@ -453,6 +479,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     }
   }
   print_table(reports, options);
+  print_switch_causes(reports);
   for (const Report& r : reports) {
     if (r.support) print_support(r.label, *r.support);
   }

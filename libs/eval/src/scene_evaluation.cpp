@@ -9,6 +9,7 @@
 #include <string>
 
 #include "evldt/events/event_validator.hpp"
+#include "evldt/lines/normal_motion.hpp"
 #include "evldt/lines/realtime_engine.hpp"
 
 namespace evldt {
@@ -110,11 +111,48 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
     accuracy_.add_step(counts_, predicted.size(), truth_.size());
     const Timestamp t = times[next_step_];
     add_to_second(t, counts_[0]);
-    tracking_.add_step(t, predicted_ids, predicted, truth_ids_, truth_);
+    const bool with_velocities = use_held && !held_velocities_.empty();
+    if (with_velocities) truth_velocities_at(next_step_);
+    tracking_.add_step(t, predicted_ids, predicted, truth_ids_, truth_,
+                       with_velocities ? std::span<const float>(held_velocities_) : std::span<const float>(),
+                       with_velocities ? std::span<const float>(truth_velocities_) : std::span<const float>());
     if (edge_recall_) {
       matchers_.front().matched_ground_truth(matched_map_);
       edge_recall_->add_step(t, truth_, truth_ids_, predicted, matched_map_);
     }
+  }
+}
+
+void StreamEvaluator::truth_velocities_at(std::size_t index) {
+  // Where each line of this step crosses the normal through the centre of its first piece, at a
+  // neighbouring step: the distance along that normal (NaN where the line is not seen).
+  const std::size_t pieces = truth_.size();
+  const auto crossings = [&](std::size_t step, std::vector<double>& along) {
+    along.assign(pieces, std::numeric_limits<double>::quiet_NaN());
+    ground_truth_.segments_at(step, neighbour_truth_, neighbour_ids_);
+    for (std::size_t piece = 0; piece < pieces; ++piece) {
+      const auto it = std::find(neighbour_ids_.begin(), neighbour_ids_.end(), truth_ids_[piece]);
+      if (it == neighbour_ids_.end()) continue;
+      const Segment& there = neighbour_truth_[static_cast<std::size_t>(it - neighbour_ids_.begin())];
+      const Point2 n = unit_normal(truth_[piece]), m = unit_normal(there);
+      const double facing = m.dot(n);
+      if (std::abs(facing) < 0.5) continue;  // turned by more than 60 degrees in a step: no crossing to speak of
+      along[piece] = m.dot(there.q0 - truth_[piece].centre()) / facing;
+    }
+  };
+  const std::vector<Timestamp>& times = ground_truth_.times;
+  const std::size_t before = index > 0 ? index - 1 : index, after = index + 1 < times.size() ? index + 1 : index;
+  std::vector<double> at_before, at_after;
+  crossings(before, at_before);
+  crossings(after, at_after);
+  truth_velocities_.assign(pieces, std::numeric_limits<float>::quiet_NaN());
+  for (std::size_t piece = 0; piece < pieces; ++piece) {
+    // A neighbour where the line is not seen gives way to this step itself (crossing at 0).
+    double from = at_before[piece], to = at_after[piece];
+    Timestamp t_from = times[before], t_to = times[after];
+    if (!std::isfinite(from)) from = 0, t_from = times[index];
+    if (!std::isfinite(to)) to = 0, t_to = times[index];
+    if (t_to > t_from) truth_velocities_[piece] = static_cast<float>((to - from) / (static_cast<double>(t_to - t_from) * 1e-6));
   }
 }
 
@@ -148,9 +186,13 @@ std::vector<Prf> StreamEvaluator::cumulative_per_second() const {
   return cumulative;
 }
 
-void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted) {
+void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted,
+                                     std::span<const float> normal_velocities) {
   if (finished_) throw std::logic_error("prediction added after finish()");
   if (ids.size() != predicted.size()) throw std::invalid_argument("a predicted step needs one id per segment");
+  if (!normal_velocities.empty() && normal_velocities.size() != predicted.size()) {
+    throw std::invalid_argument("a predicted step needs one velocity per segment, or none");
+  }
   if (holding_ && t < held_t_) throw std::invalid_argument("predicted steps must not go back in time");
   lifetimes_.observe_step(t, ids);
   if (!holding_ || t > held_t_) {
@@ -165,6 +207,7 @@ void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t>
   held_t_ = t;
   held_ids_.assign(ids.begin(), ids.end());
   held_.assign(predicted.begin(), predicted.end());
+  held_velocities_.assign(normal_velocities.begin(), normal_velocities.end());
 }
 
 void StreamEvaluator::finish() {
@@ -231,15 +274,18 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
   DeterministicPipeline pipeline(config);
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted, step_segments;
+  std::vector<float> velocities;
   WholeLineSupport support;
   const auto add = [&](StreamEvaluator& to, Timestamp t, std::span<const TrackedLine> lines) {
     ids.clear();
     predicted.clear();
+    velocities.clear();
     for (const TrackedLine& line : lines) {
       ids.push_back(line.id);
       predicted.push_back(line.segment);
+      velocities.push_back(line.normal_velocity);
     }
-    to.add_prediction(t, ids, predicted);
+    to.add_prediction(t, ids, predicted, velocities);
   };
   pipeline.set_output(
       step_us,

@@ -8,6 +8,7 @@
 
 #include "evldt/eval/assignment.hpp"
 #include "evldt/eval/line_heatmap.hpp"
+#include "evldt/lines/normal_motion.hpp"
 
 namespace evldt {
 
@@ -26,6 +27,14 @@ double squared_distance_to_segment(double px, double py, const Segment& s) {
 }
 
 bool finite(const Segment& s) { return s.q0.allFinite() && s.q1.allFinite(); }
+
+double median_of(std::vector<double> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  if (values.size() % 2 == 1) return *middle;
+  return 0.5 * (*middle + *std::max_element(values.begin(), middle));
+}
 
 double ratio(double numerator, double denominator) {
   return denominator > 0 ? numerator / denominator : std::numeric_limits<double>::quiet_NaN();
@@ -106,10 +115,16 @@ double TrackingEvaluator::measure_overlaps(const Segment& whole_segment, std::sp
 
 void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> predicted_ids,
                                  std::span<const Segment> predicted, std::span<const std::uint64_t> truth_ids,
-                                 std::span<const Segment> truth) {
+                                 std::span<const Segment> truth, std::span<const float> predicted_velocities,
+                                 std::span<const float> truth_velocities) {
   if (predicted_ids.size() != predicted.size() || truth_ids.size() != truth.size()) {
     throw std::invalid_argument("tracking step: ids and segments differ in number");
   }
+  if ((!predicted_velocities.empty() && predicted_velocities.size() != predicted.size()) ||
+      (!truth_velocities.empty() && truth_velocities.size() != truth.size())) {
+    throw std::invalid_argument("tracking step: velocities and segments differ in number");
+  }
+  const bool compare_velocities = !predicted_velocities.empty() && !truth_velocities.empty();
   if (stepped_ && t < last_t_) throw std::invalid_argument("tracking steps must come in time order");
   stepped_ = true;
   last_t_ = t;
@@ -122,6 +137,8 @@ void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> pre
     if (slot_of_line_[line] == kNoSlot) {
       slot_of_line_[line] = step_lines_.size();
       step_lines_.push_back(line);
+      first_piece_.resize(step_lines_.size());
+      first_piece_.back() = piece;
     }
     if (const auto visible = clipped_to_sensor(truth[piece], sensor_)) ground_truth_px_ += visible->length();
   }
@@ -129,7 +146,12 @@ void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> pre
   hit_stamp_.resize(step_lines_.size());
 
   matches_.clear();
+  const std::size_t step = steps_++;
+  std::vector<std::pair<std::uint64_t, std::size_t>>& published = ids_at_step_.emplace_back();
   for (std::size_t i = 0; i < predicted.size(); ++i) {
+    const auto [sighting, first] = sightings_.try_emplace(predicted_ids[i], IdSightings{step, step});
+    sighting->second.last_step = step;
+    published.emplace_back(predicted_ids[i], kNoSlot);
     const double length = measure_overlaps(predicted[i], truth);
     predicted_px_ += length;
     std::size_t best = kNoSlot;
@@ -143,11 +165,24 @@ void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> pre
     }
     if (best == kNoSlot || overlap_by_line_[best] < min_overlap_ * length) continue;
     const std::size_t line = step_lines_[best];
+    published.back().second = line;
+    if (compare_velocities) {
+      const std::size_t piece = first_piece_[best];
+      const double truth_velocity = truth_velocities[piece];
+      if (std::isfinite(truth_velocity) && std::isfinite(predicted_velocities[i])) {
+        // Along the true line's normal: a segment drawn the other way round has the opposite one.
+        const double sign = unit_normal(predicted[i]).dot(unit_normal(truth[piece])) < 0 ? -1.0 : 1.0;
+        const double error = std::abs(sign * predicted_velocities[i] - truth_velocity);
+        velocity_errors_.push_back(error);
+        if (std::abs(truth_velocity) >= kMinRelativeSpeed) relative_velocity_errors_.push_back(error / std::abs(truth_velocity));
+      }
+    }
     matches_.push_back({line, predicted_ids[i], overlap_by_line_[best]});
     pair_overlap_px_[(static_cast<std::uint64_t>(predicted_index(predicted_ids[i])) << 32) | line] +=
         overlap_by_line_[best];
   }
 
+  std::sort(published.begin(), published.end());
   // Each line's matches together, the one covering most of it first (ties: the lower id).
   std::sort(matches_.begin(), matches_.end(), [](const Match& a, const Match& b) {
     if (a.line != b.line) return a.line < b.line;
@@ -171,11 +206,41 @@ void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> pre
       ids_of_line_[line].insert(m->id);
       if (previous.matched && m->id == previous.id) representative = previous.id;
     }
-    if (previous.matched && representative != previous.id) ++track.id_switches;
+    if (previous.matched && representative != previous.id) {
+      ++track.id_switches;
+      switches_.push_back({line, step, previous.id, representative, !track.owners.empty() && !track.owners.back().matched});
+    }
     track.distinct_ids = ids_of_line_[line].size();
     track.owners.push_back({t, true, representative});
     last_owner_[line] = track.owners.back();
   }
+}
+
+IdSwitchCauses TrackingEvaluator::classify_switches() const {
+  IdSwitchCauses causes;
+  for (const Switch& sw : switches_) {
+    if (sw.after_gap) ++causes.after_gap;
+    const auto& published = ids_at_step_[sw.step];
+    const auto it = std::lower_bound(published.begin(), published.end(), std::pair(sw.old_id, std::size_t{0}));
+    if (it != published.end() && it->first == sw.old_id) {
+      // Published: it no longer matches this line, or the representative would have stayed.
+      if (it->second != kNoSlot) {
+        ++causes.to_other_edge;
+      } else {
+        ++causes.off_edge;
+      }
+      continue;
+    }
+    const IdSightings& old_seen = sightings_.at(sw.old_id);
+    if (old_seen.last_step > sw.step) {
+      ++causes.returned;
+    } else if (sightings_.at(sw.new_id).first_step > old_seen.last_step) {
+      ++causes.redetected;
+    } else {
+      ++causes.taken_over;
+    }
+  }
+  return causes;
 }
 
 TrackingSummary TrackingEvaluator::summary() const {
@@ -204,9 +269,16 @@ TrackingSummary TrackingEvaluator::summary() const {
   for (const auto& [key, overlap] : overlaps) {
     pairs.push_back({static_cast<std::uint32_t>(key >> 32), static_cast<std::uint32_t>(key & 0xffffffffu), overlap});
   }
+  double matched_px = 0;
+  for (const WeightedPair& pair : pairs) matched_px += pair.weight;
   for (const std::size_t chosen : max_weight_matching(index_of_predicted_id_.size(), lines_.size(), pairs)) {
     s.id_true_positive_px += pairs[chosen].weight;
   }
+  s.unassigned_matched_px = matched_px - s.id_true_positive_px;
+  s.velocity_pairs = velocity_errors_.size();
+  s.velocity_error_median = median_of(velocity_errors_);
+  s.velocity_relative_median = median_of(relative_velocity_errors_);
+  s.switch_causes = classify_switches();
   s.predicted_px = predicted_px_;
   s.ground_truth_px = ground_truth_px_;
   s.id_precision = ratio(s.id_true_positive_px, predicted_px_);

@@ -10,7 +10,7 @@ DeterministicPipeline::DeterministicPipeline(const PipelineConfig& config, bool 
     : config_(config),
       filters_(config.filters, config.lattice.sensor),
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha, keep_surface),
-      lines_(lattice_.geometry(), config.track.reassociation),
+      lines_(lattice_.geometry(), config.track.reassociation, config.track.motion),
       pool_(config.threads),
       detector_(lattice_.geometry(), config.score, &pool_),
       tracker_(lattice_.geometry(), config.score, config.track, &pool_) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -18,15 +19,18 @@ std::string_view reason_name(ReleaseReason reason) {
   return "?";
 }
 
-LineMap::LineMap(const LatticeGeometry& geometry, const ReassociationParams& reassociation)
+LineMap::LineMap(const LatticeGeometry& geometry, const ReassociationParams& reassociation, const MotionParams& motion)
     : geometry_(geometry),
       reassociation_(reassociation),
+      motion_params_(motion),
       min_cos_angle_(std::cos(reassociation.max_angle_deg * std::numbers::pi_v<float> / 180.0f)),
       released_by_block_(static_cast<std::size_t>(geometry.block_count())),
       status_(static_cast<std::size_t>(geometry.block_count()), BlockStatus::NoDetect),
       owner_(static_cast<std::size_t>(geometry.block_count()), -1) {
   lines_.reserve(static_cast<std::size_t>(geometry.block_count()));  // at most one line per block
   settled_.reserve(lines_.capacity());
+  motion_.reserve(lines_.capacity());
+  band_centre_.reserve(lines_.capacity());
 }
 
 void LineMap::set_block_status(int block, BlockStatus status) {
@@ -44,20 +48,41 @@ std::uint64_t LineMap::add(const Segment& segment, float score, int admin_block,
   line.admin_block = admin_block;
   line.first_seen_us = now;
   line.last_good_us = now;
+  NormalMotion motion;
+  start_motion(motion, segment, now, motion_params_);
+  // The edge's motion goes on: the new segment is where the edge is now, moving as it did.
+  const auto take_velocity = [&](const NormalMotion& edge) {
+    if (!edge.started) return;
+    motion.velocity = unit_normal(segment).dot(edge.normal) < 0 ? -edge.velocity : edge.velocity;
+    motion.var_velocity = edge.var_velocity;
+  };
   if (ReleasedLine* earlier = find_released(segment, admin_block, now)) {
     line.id = earlier->id;
     line.first_seen_us = earlier->first_seen_us;
     released_lifetimes_.take_back(earlier->last_good_us - earlier->first_seen_us);
     earlier->present = false;
     ++reassociated_;
+    take_velocity(earlier->motion);
   } else {
     line.id = next_id_++;
+    if (const NormalMotion* along = neighbour_motion(segment, admin_block)) take_velocity(*along);
   }
+  line.normal_velocity = motion.velocity;
+  line.normal_velocity_std = motion.velocity_std();
   status_[admin_block] = BlockStatus::Owned;
   owner_[admin_block] = static_cast<std::int32_t>(lines_.size());
   lines_.push_back(line);
   settled_.push_back(0);
+  motion_.push_back(motion);
+  band_centre_.push_back(segment.centre());
   return line.id;
+}
+
+float LineMap::offset_along(const Segment& line, Point2 direction, Point2 centre) const {
+  const Point2 along = line.q1 - line.q0;
+  const float length = along.norm();
+  if (!(length > 0) || std::abs(direction.dot(along)) < min_cos_angle_ * length) return std::numeric_limits<float>::infinity();
+  return std::abs(cross2(along, centre - line.q0)) / length;
 }
 
 LineMap::ReleasedLine* LineMap::find_released(const Segment& segment, int block, Timestamp now) {
@@ -74,13 +99,29 @@ LineMap::ReleasedLine* LineMap::find_released(const Segment& segment, int block,
     for (int ni = std::max(0, i - 1); ni <= std::min(geometry_.blocks_x - 1, i + 1); ++ni) {
       ReleasedLine& candidate = released_by_block_[static_cast<std::size_t>(geometry_.index(ni, nj))];
       if (!candidate.present || now - candidate.last_good_us > reassociation_.window_us) continue;
-      const Point2 along = candidate.segment.q1 - candidate.segment.q0;
-      const float candidate_length = along.norm();
-      if (!(candidate_length > 0)) continue;
-      if (std::abs(direction.dot(along)) < min_cos_angle_ * candidate_length) continue;
-      const float offset = std::abs(cross2(along, centre - candidate.segment.q0)) / candidate_length;
+      const float offset = offset_along(candidate.segment, direction, centre);
       if (offset > max_offset || (best != nullptr && offset >= best_offset)) continue;
       best = &candidate;
+      best_offset = offset;
+    }
+  }
+  return best;
+}
+
+const NormalMotion* LineMap::neighbour_motion(const Segment& segment, int block) const {
+  const float max_offset = reassociation_.max_offset_ratio * static_cast<float>(geometry_.block_size);
+  const Point2 direction = (segment.q1 - segment.q0).normalized(), centre = segment.centre();
+  const NormalMotion* best = nullptr;
+  float best_offset = 0;
+  const int i = geometry_.column(block), j = geometry_.row(block);
+  for (int nj = std::max(0, j - 1); nj <= std::min(geometry_.blocks_y - 1, j + 1); ++nj) {
+    for (int ni = std::max(0, i - 1); ni <= std::min(geometry_.blocks_x - 1, i + 1); ++ni) {
+      const int owner = owner_[static_cast<std::size_t>(geometry_.index(ni, nj))];
+      if (owner < 0) continue;
+      const auto index = static_cast<std::size_t>(owner);
+      const float offset = offset_along(lines_[index].segment, direction, centre);
+      if (!motion_[index].started || offset > max_offset || (best != nullptr && offset >= best_offset)) continue;
+      best = &motion_[index];
       best_offset = offset;
     }
   }
@@ -91,16 +132,21 @@ void LineMap::release(std::size_t index, ReleaseReason reason) {
   const int block = lines_[index].admin_block;
   const TrackedLine& gone = lines_[index];
   released_lifetimes_.add(gone.last_good_us - gone.first_seen_us);
-  released_by_block_[static_cast<std::size_t>(block)] = {true, gone.id, gone.segment, gone.first_seen_us, gone.last_good_us};
+  released_by_block_[static_cast<std::size_t>(block)] = {true, gone.id, gone.segment, gone.first_seen_us, gone.last_good_us,
+                                                         motion_[index]};
   status_[block] = BlockStatus::NoDetect;
   owner_[block] = -1;
   if (index + 1 != lines_.size()) {
     lines_[index] = lines_.back();
     settled_[index] = settled_.back();
+    motion_[index] = motion_.back();
+    band_centre_[index] = band_centre_.back();
     owner_[lines_[index].admin_block] = static_cast<std::int32_t>(index);
   }
   lines_.pop_back();
   settled_.pop_back();
+  motion_.pop_back();
+  band_centre_.pop_back();
   ++released_[static_cast<int>(reason)];
 }
 
@@ -171,6 +217,18 @@ void LineMap::clear() {
   std::fill(released_by_block_.begin(), released_by_block_.end(), ReleasedLine{});
   lines_.clear();
   settled_.clear();
+  motion_.clear();
+  band_centre_.clear();
+}
+
+void LineMap::observe_motion(Timestamp now) {
+  for (std::size_t i = 0; i < lines_.size(); ++i) {
+    TrackedLine& line = lines_[i];
+    if (line.status != LineStatus::GoodTrack) continue;
+    evldt::observe_motion(motion_[i], line.segment, band_centre_[i], now, motion_params_);
+    line.normal_velocity = motion_[i].velocity;
+    line.normal_velocity_std = motion_[i].velocity_std();
+  }
 }
 
 }  // namespace evldt

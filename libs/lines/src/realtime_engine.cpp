@@ -22,7 +22,7 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
       detect_{ScarfLattice(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha)},
       track_{ScarfLattice(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha)},
-      lines_(lattice_.geometry(), config.track.reassociation),
+      lines_(lattice_.geometry(), config.track.reassociation, config.track.motion),
       pool_(config.threads),
       detector_(lattice_.geometry(), config.score, &pool_),
       tracker_(lattice_.geometry(), config.score, config.track, &pool_) {

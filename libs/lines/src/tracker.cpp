@@ -106,7 +106,7 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
       if (begin >= n) return;
       for (std::size_t i = begin; i < std::min(n, begin + kLinesPerClaim); ++i) {
         ReleaseReason reason{};
-        outcome_[i] = track_line(lattice, all[i], lines.settled_version(i), now, settled_ok, worker, reason)
+        outcome_[i] = track_line(lattice, all[i], lines.settled_version(i), lines.band_centre(i), now, settled_ok, worker, reason)
                           ? kKept
                           : static_cast<std::uint8_t>(reason);
       }
@@ -129,10 +129,11 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
     outcome_.pop_back();
   }
   lines.manage(kSuppressRatio);
+  lines.observe_motion(now);
 }
 
-bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, std::uint64_t& settled_version, Timestamp now,
-                             bool settled_ok, Worker& worker, ReleaseReason& reason) const {
+bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, std::uint64_t& settled_version,
+                             Point2& band_centre, Timestamp now, bool settled_ok, Worker& worker, ReleaseReason& reason) const {
   const float b = static_cast<float>(geometry_.block_size);
   if (line.segment.length() < 0.5f * b) {
     reason = ReleaseReason::TooShort;
@@ -195,6 +196,10 @@ bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, std
   if (best == 0 && hypotheses[0].q0 == line.segment.q0 && hypotheses[0].q1 == line.segment.q1) settled_version = newest;
   line.segment = hypotheses[best];
   line.score = best_score.score();
+  band_centre = line.segment.centre();
+  if (best_score.inliers > 0) {
+    band_centre += unit_normal(line.segment) * (best_score.inlier_offset_sum / static_cast<float>(best_score.inliers));
+  }
   return judge(line, now, reason);
 }
 

@@ -15,7 +15,9 @@ std::span<const TrackedLine> WholeLineStage::step(Timestamp t, std::span<const T
                       .status = LineStatus::GoodTrack,
                       .admin_block = -1,
                       .first_seen_us = line.first_seen_us,
-                      .last_good_us = line.last_seen_us});
+                      .last_good_us = line.last_seen_us,
+                      .normal_velocity = line.normal_velocity,
+                      .normal_velocity_std = line.normal_velocity_std});
   }
   return lines_;
 }

@@ -321,6 +321,10 @@ py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<
   const TrackingSummary tracking = evaluator->tracking().summary();
   out["idf1"] = tracking.idf1;
   out["id_switches"] = tracking.id_switches;
+  // None where no pair had a velocity (rows carry none), as the JSON's null.
+  const auto defined = [](double value) { return std::isnan(value) ? py::object(py::none()) : py::object(py::float_(value)); };
+  out["vel_err_med"] = defined(tracking.velocity_error_median);
+  out["vel_rel_med"] = defined(tracking.velocity_relative_median);
   out["ids_per_line"] = tracking.ids_per_line;
   out["coverage"] = tracking.coverage;
   out["steps_without_prediction"] = evaluator->coverage().steps_without_prediction;

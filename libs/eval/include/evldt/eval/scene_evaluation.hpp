@@ -65,8 +65,10 @@ class StreamEvaluator {
   StreamEvaluator(SensorSize sensor, std::vector<double> tolerance_fractions, GroundTruthSteps ground_truth,
                   Timestamp hold_us);
   /// One predicted step; times must not decrease (throws std::invalid_argument), and a step at the
-  /// time of the previous one replaces it.
-  void add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted);
+  /// time of the previous one replaces it. normal_velocities (px/s, one per segment, or empty when
+  /// not known) are scored against the true lines' (TrackingSummary::velocity_error_median).
+  void add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted,
+                      std::span<const float> normal_velocities = {});
   /// Scores the ground-truth steps after the last prediction; call once, after the last add_prediction.
   void finish();
 
@@ -92,6 +94,10 @@ class StreamEvaluator {
  private:
   /// Scores every ground-truth step before `until` against the held prediction.
   void score_steps_before(Timestamp until);
+  /// The true lines' velocities across themselves at step `index`, one per piece of truth_ (NaN
+  /// where the line is seen at neither neighbouring step): central differences of where each line
+  /// lies along the normal of its first piece, through that piece's centre.
+  void truth_velocities_at(std::size_t index);
   /// Adds a step's counts at the first tolerance to its second.
   void add_to_second(Timestamp t, const MatchCounts& counts);
 
@@ -109,6 +115,10 @@ class StreamEvaluator {
   Timestamp held_t_ = 0;
   std::vector<std::uint64_t> held_ids_;
   std::vector<Segment> held_;
+  std::vector<float> held_velocities_;
+  std::vector<float> truth_velocities_;
+  std::vector<Segment> neighbour_truth_;
+  std::vector<std::uint64_t> neighbour_ids_;
   std::vector<std::uint64_t> truth_ids_;
   std::vector<Segment> truth_;
   std::vector<MatchCounts> counts_;

@@ -46,7 +46,8 @@ struct LifetimeStats {
 
 class LineMap {
  public:
-  explicit LineMap(const LatticeGeometry& geometry, const ReassociationParams& reassociation = {});
+  explicit LineMap(const LatticeGeometry& geometry, const ReassociationParams& reassociation = {},
+                   const MotionParams& motion = {});
 
   [[nodiscard]] const std::vector<TrackedLine>& lines() const { return lines_; }
   /// The lines, to change in place (their number changes only through add and release).
@@ -55,13 +56,24 @@ class LineMap {
   /// last pass, if that pass left the segment where it was; 0 otherwise. While its blocks keep that
   /// version a pass would repeat itself exactly, so the tracker reuses its score.
   [[nodiscard]] std::uint64_t& settled_version(std::size_t index) { return settled_[index]; }
+  /// Where the middle of lines()[index]'s event band lay at its last tracking pass (a point, off
+  /// the segment along its normal by the inliers' mean offset): finer than the segment's own place,
+  /// whose ends move in steps of dq.
+  [[nodiscard]] Point2& band_centre(std::size_t index) { return band_centre_[index]; }
+  /// The estimate of lines()[index]'s motion across itself.
+  [[nodiscard]] const NormalMotion& motion(std::size_t index) const { return motion_[index]; }
+  /// Observes where each line's band is after a tracking round at `now` (of those with a good
+  /// track: a bad one's place says nothing of its edge) and sets its normal_velocity and
+  /// normal_velocity_std.
+  void observe_motion(Timestamp now);
   [[nodiscard]] BlockStatus block_status(int block) const { return status_[block]; }
   void set_block_status(int block, BlockStatus status);
 
-  /// Creates a line administered by a free block; returns its id. The line takes over the id and
-  /// first-seen time of a line released from this block or a neighbour within the reassociation
-  /// window when it lies along it (angle and offset within bounds; of several, the nearest),
-  /// else it gets a new id.
+  /// Creates a line administered by a free block; returns its id. The line takes over the id,
+  /// first-seen time and velocity of a line released from this block or a neighbour within the
+  /// reassociation window when it lies along it (angle and offset within bounds; of several, the
+  /// nearest), else it gets a new id and the velocity of a live line it lies along in this block or
+  /// a neighbour (neighbour_motion), if any.
   std::uint64_t add(const Segment& segment, float score, int admin_block, Timestamp now);
   /// Removes the line at `index` (swap-remove: the last line takes its place) and frees its block.
   void release(std::size_t index, ReleaseReason reason);
@@ -89,14 +101,22 @@ class LineMap {
     Segment segment;
     Timestamp first_seen_us = 0;
     Timestamp last_good_us = 0;
+    NormalMotion motion;
   };
   void transfer_ownership();
   void suppress_detection(float suppress_ratio);
+  /// How far `centre` lies from `line`, if a segment along unit `direction` through it lies along
+  /// the line within the reassociation angle; infinity if not.
+  [[nodiscard]] float offset_along(const Segment& line, Point2 direction, Point2 centre) const;
+  /// The motion of a live line in `block` or a neighbour that a new segment there lies along (as
+  /// find_released asks), the nearest; or nullptr.
+  [[nodiscard]] const NormalMotion* neighbour_motion(const Segment& segment, int block) const;
   /// The remembered line a new segment in `block` continues, or nullptr.
   ReleasedLine* find_released(const Segment& segment, int block, Timestamp now);
 
   LatticeGeometry geometry_;
   ReassociationParams reassociation_;
+  MotionParams motion_params_;
   float min_cos_angle_ = 1;
   std::vector<ReleasedLine> released_by_block_;  ///< per block: the last line released from it
   std::uint64_t reassociated_ = 0;
@@ -104,6 +124,8 @@ class LineMap {
   std::vector<std::int32_t> owner_;  ///< per block: index into lines_ of the line it administers, or -1
   std::vector<TrackedLine> lines_;
   std::vector<std::uint64_t> settled_;  ///< per line, settled_version()
+  std::vector<NormalMotion> motion_;     ///< per line, motion()
+  std::vector<Point2> band_centre_;      ///< per line, band_centre()
   std::uint64_t first_id_ = 1;
   std::uint64_t next_id_ = 1;
   std::uint64_t released_[kReleaseReasonCount] = {};

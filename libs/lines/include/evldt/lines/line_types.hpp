@@ -33,6 +33,10 @@ struct TrackedLine {
   int admin_block = -1;
   Timestamp first_seen_us = 0;
   Timestamp last_good_us = 0;  ///< last time its score was above threshold (detection counts)
+  /// How fast it moves across itself, px/s along its normal (-(y1 - y0), x1 - x0) / length, and the
+  /// standard deviation of that estimate (normal_motion.hpp).
+  float normal_velocity = 0;
+  float normal_velocity_std = 0;
 };
 
 /// A whole line as the whole-line tracker keeps it.
@@ -42,6 +46,8 @@ struct WholeLine {
   std::uint32_t segments = 0;   ///< block segments joined into it at this step
   Timestamp first_seen_us = 0;  ///< when its track began
   Timestamp last_seen_us = 0;
+  float normal_velocity = 0;  ///< as TrackedLine's, along this segment's normal
+  float normal_velocity_std = 0;
 };
 
 }  // namespace evldt

@@ -7,6 +7,7 @@
 
 #include "evldt/events/event.hpp"
 #include "evldt/filters/filter_chain.hpp"
+#include "evldt/lines/normal_motion.hpp"
 #include "evldt/lines/rectifier.hpp"
 
 namespace evldt {
@@ -51,6 +52,7 @@ struct TrackParams {
   Timestamp bad_track_patience_us = 30'000;
   EffectiveRatioNorm multi_block_norm = EffectiveRatioNorm::Block;
   ReassociationParams reassociation;
+  MotionParams motion;
 };
 
 struct ScheduleParams {

@@ -56,8 +56,8 @@ class LineTracker {
   };
   /// Tracks one line; false when it must be released (reason set). settled_version: its
   /// LineMap::settled_version; settled_ok: versions of this lattice may be compared with it.
-  bool track_line(const ScarfLattice& lattice, TrackedLine& line, std::uint64_t& settled_version, Timestamp now, bool settled_ok,
-                  Worker& worker, ReleaseReason& reason) const;
+  bool track_line(const ScarfLattice& lattice, TrackedLine& line, std::uint64_t& settled_version, Point2& band_centre,
+                  Timestamp now, bool settled_ok, Worker& worker, ReleaseReason& reason) const;
   /// Status after a pass that left line.score: good, or bad and released once out of patience.
   bool judge(TrackedLine& line, Timestamp now, ReleaseReason& reason) const;
 

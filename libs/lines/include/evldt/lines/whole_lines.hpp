@@ -24,7 +24,8 @@ class WholeLineTracker {
   explicit WholeLineTracker(int block_size, const WholeLineParams& params = {}, std::uint64_t first_id = 1);
 
   /// One step. Each line tracked so far, the first published first, takes back the segments it held
-  /// that still lie along it and grows along its edge over free segments (taking over a younger
+  /// that still lie along it, where its velocity has taken it since it last held segments (for at
+  /// most 20 ms), and grows along its edge over free segments (taking over a younger
   /// line's segments where they fit, which merges the two). A published line that finds none waits
   /// keep_id_us under its last geometry and may take segments up again, from those left by the
   /// published lines that took theirs back; one never published ends.
@@ -61,6 +62,7 @@ class WholeLineTracker {
     Timestamp last_seen_us = 0;              ///< last step with segments
     std::array<Timestamp, 2> end_seen_us{};  ///< last step the segments reached the t_min / t_max end
     std::uint32_t segments = 0;
+    float velocity = 0, velocity_std = 0;  ///< across the model's normal (-direction.y, direction.x), px/s
   };
   /// A line being grown this step: the length-weighted fit through its members' ends.
   struct Cluster {
@@ -109,6 +111,13 @@ class WholeLineTracker {
   [[nodiscard]] float events_reach(Point2 from, Point2 direction, float max_length) const;
   /// Moves the ends of published lines that make a corner to the corner (WholeLineParams::corner_*).
   void meet_at_corners();
+  /// Where `track`'s line is expected at time t: its last geometry moved across itself by its
+  /// velocity for the time since it last held segments (at most kMaxPredictionUs).
+  [[nodiscard]] LineModel expected_model(const Track& track, Timestamp t) const;
+  /// The motion of cluster c from its members': their velocities along its normal, weighted by the
+  /// inverse of their variances; the deviation of that mean, widened by the members' disagreement.
+  [[nodiscard]] std::pair<float, float> cluster_motion(std::size_t c, std::uint32_t members,
+                                                       std::span<const TrackedLine> segments) const;
   /// `track` followed by cluster `c`: new geometry, remembered ends, times.
   void continue_track(Track& track, const Cluster& cluster, std::uint32_t members, Timestamp t) const;
 
