@@ -47,7 +47,7 @@ run "$work/rec/events.raw" -o "$work/a.csv" >"$work/summary_a.txt"
 run "$work/rec/events.raw" -o "$work/b.csv" >/dev/null
 cmp -s "$work/a.csv" "$work/b.csv" || fail "two runs differ"
 [[ $(wc -l <"$work/a.csv") -gt 100 ]] || fail "too few segment rows: $(wc -l <"$work/a.csv")"
-head -1 "$work/a.csv" | grep -qx "t_us,id,x0,y0,x1,y1,score,status" || fail "CSV header"
+head -1 "$work/a.csv" | grep -qx "t_us,id,x0,y0,x1,y1,score,status,normal_velocity,normal_velocity_std" || fail "CSV header"
 echo "ok: two runs give byte-identical CSV ($(wc -l <"$work/a.csv") rows)"
 
 # The same events through every reader, and straight from the simulator, give the same segments.

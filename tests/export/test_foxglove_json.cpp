@@ -49,5 +49,17 @@ TEST(ImageAnnotations, ALineListPerStatusColourScaledAndIdsAtTheCentres) {
   EXPECT_EQ(image_annotations_json(0, {}, AnnotationStyle{}, 1), R"({"circles": [], "points": [], "texts": []})");
 }
 
+TEST(ImageAnnotations, WithMotionEachLineGetsAnArrowAndItsVelocityInItsText) {
+  TrackedLine moving = line(7, 1, 2, 11, 2, LineStatus::GoodTrack);
+  moving.normal_velocity = -50;  // up the image, for a line drawn left to right: 5 px in 0.1 s
+  const AnnotationStyle whole{.thickness = 2, .by_status = false, .ids = true, .motion = true};
+  const std::string json = image_annotations_json(0, std::span(&moving, 1), whole, 2);
+  // The arrow from the middle (6, 2) to (6, -3), scaled by 2, in orange.
+  EXPECT_NE(json.find(R"("points": [{"x": 12.00, "y": 4.00}, {"x": 12.00, "y": -6.00}], "outline_color": {"r": 1.000, "g": 0.550, "b": 0.000, "a": 1.000})"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find(R"("text": "7 -50 px/s")"), std::string::npos) << json;
+}
+
 }  // namespace
 }  // namespace evldt

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "evldt/lines/segment_csv.hpp"
@@ -15,6 +16,8 @@ TEST(SegmentCsv, RoundTripSortedByIdAndMalformedRowsNamed) {
   lines[0].segment = {Point2(1.25f, 2.5f), Point2(3.0f, 4.125f)};
   lines[0].score = 0.5f;
   lines[0].status = LineStatus::BadTrack;
+  lines[0].normal_velocity = -12.25f;
+  lines[0].normal_velocity_std = 3.5f;
   lines[1].id = 4;
   lines[1].segment = {Point2(10, 20), Point2(30, 40)};
   lines[1].status = LineStatus::GoodTrack;
@@ -32,15 +35,29 @@ TEST(SegmentCsv, RoundTripSortedByIdAndMalformedRowsNamed) {
   EXPECT_EQ(rows[1].segment.q1, Point2(3.0f, 4.125f));
   EXPECT_FLOAT_EQ(rows[1].score, 0.5f);
   EXPECT_EQ(rows[1].status, LineStatus::BadTrack);
+  EXPECT_FLOAT_EQ(rows[1].normal_velocity, -12.2f);  // to 0.1 px/s, rounded to even
+  EXPECT_FLOAT_EQ(rows[1].normal_velocity_std, 3.5f);
 
-  std::ofstream(dir / "bad.csv") << kSegmentCsvHeader << "\n1,2,3,4,5,6,0.5,good\n7,8,9\n";
+  // A file written before the velocity columns: read, its velocities unknown.
+  std::ofstream(dir / "old.csv") << kSegmentCsvHeaderWithoutVelocity << "\n1,2,3,4,5,6,0.5,good\n";
+  const auto old_rows = read_segment_csv(dir / "old.csv");
+  ASSERT_EQ(old_rows.size(), 1u);
+  EXPECT_EQ(old_rows[0].status, LineStatus::GoodTrack);
+  EXPECT_TRUE(std::isnan(old_rows[0].normal_velocity));
+  // ... but a row of the old form under the new header is malformed, as are trailing fields.
+  std::ofstream(dir / "short.csv") << kSegmentCsvHeader << "\n1,2,3,4,5,6,0.5,good\n";
+  EXPECT_THROW(read_segment_csv(dir / "short.csv"), std::runtime_error);
+  std::ofstream(dir / "long.csv") << kSegmentCsvHeader << "\n1,2,3,4,5,6,0.5,good,1,2,3\n";
+  EXPECT_THROW(read_segment_csv(dir / "long.csv"), std::runtime_error);
+
+  std::ofstream(dir / "bad.csv") << kSegmentCsvHeader << "\n1,2,3,4,5,6,0.5,good,1.0,2.0\n7,8,9\n";
   try {
     read_segment_csv(dir / "bad.csv");
     FAIL() << "malformed row accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("bad.csv:3:"), std::string::npos) << e.what();
   }
-  std::ofstream(dir / "status.csv") << kSegmentCsvHeader << "\n1,2,3,4,5,6,0.5,great\n";
+  std::ofstream(dir / "status.csv") << kSegmentCsvHeader << "\n1,2,3,4,5,6,0.5,great,0,0\n";
   EXPECT_THROW(read_segment_csv(dir / "status.csv"), std::runtime_error);
   std::ofstream(dir / "header.csv") << "t,id\n";
   EXPECT_THROW(read_segment_csv(dir / "header.csv"), std::runtime_error);

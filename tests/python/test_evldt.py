@@ -79,6 +79,8 @@ def assert_rows_equal(got, expected):
     for field in ("x0", "y0", "x1", "y1"):
         np.testing.assert_allclose(got[field], [float(r[field]) for r in expected], rtol=0, atol=5.1e-4)
     np.testing.assert_allclose(got["score"], [float(r["score"]) for r in expected], rtol=0, atol=5.1e-5)
+    for field in ("normal_velocity", "normal_velocity_std"):
+        np.testing.assert_allclose(got[field], [float(r[field]) for r in expected], rtol=0, atol=0.051)
     assert [evldt.STATUS_NAMES[s] for s in got["status"]] == [r["status"] for r in expected]
 
 
@@ -165,7 +167,7 @@ def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
     segments = np.zeros(len(rows), dtype=evldt.SEGMENT_DTYPE)
     segments["t"] = [int(r["t_us"]) for r in rows]
     segments["id"] = [int(r["id"]) for r in rows]
-    for field in ("x0", "y0", "x1", "y1"):
+    for field in ("x0", "y0", "x1", "y1", "normal_velocity"):
         segments[field] = np.array([r[field] for r in rows], dtype=np.float32)
     truth_rows = read_csv(truth_csv)
     truth = np.zeros(len(truth_rows), dtype=evldt.GROUND_TRUTH_DTYPE)
@@ -183,6 +185,8 @@ def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
     assert got["lifetime_mean_ms"] == pytest.approx(reference["lifetime"]["mean_ms"])
     assert got["coverage"] == pytest.approx(reference["tracking"]["coverage"])
     assert got["idf1"] == pytest.approx(reference["tracking"]["idf1"])
+    assert got["vel_err_med"] == pytest.approx(reference["tracking"]["vel_err_med"])
+    assert got["vel_rel_med"] == pytest.approx(reference["tracking"]["vel_rel_med"])
     # The same run on a clock of Unix-epoch microseconds, as DV writes them (issue 49): the same figures.
     epoch = 1_600_000_000_000_000
     segments["t"] += epoch

@@ -39,8 +39,8 @@ TEST(ToggleLayer, EachKeyFlipsItsLayerAndOtherKeysNothing) {
   const std::vector<std::pair<int, bool RenderOptions::*>> keys = {
       {'e', &RenderOptions::show_events},      {'s', &RenderOptions::show_segments},
       {'b', &RenderOptions::show_bad_tracks},  {'w', &RenderOptions::show_whole_lines},
-      {'i', &RenderOptions::show_whole_line_ids}, {'n', &RenderOptions::show_segment_ids},
-      {'g', &RenderOptions::show_grid}};
+      {'i', &RenderOptions::show_whole_line_ids}, {'m', &RenderOptions::show_motion},
+      {'n', &RenderOptions::show_segment_ids},    {'g', &RenderOptions::show_grid}};
   for (const auto& [key, shown] : keys) {
     const RenderOptions before = options;
     EXPECT_TRUE(toggle_layer(options, key)) << static_cast<char>(key);
@@ -55,7 +55,7 @@ TEST(ToggleLayer, EachKeyFlipsItsLayerAndOtherKeysNothing) {
   EXPECT_FALSE(toggle_layer(options, 'x'));
   EXPECT_FALSE(toggle_layer(options, -1));  // no key pressed
   for (const auto& [key, shown] : keys) EXPECT_EQ(options.*shown, before.*shown);
-  EXPECT_EQ(layer_key_help(), (std::vector<std::string>{"keys: e events", "s segments", "b bad tracks", "w whole lines", "i whole-line ids",
+  EXPECT_EQ(layer_key_help(), (std::vector<std::string>{"keys: e events", "s segments", "b bad tracks", "w whole lines", "i whole-line ids", "m motion",
                                                         "n segment ids", "g block grid", "q quit"}));
 }
 
@@ -93,6 +93,25 @@ TEST(RenderScene, LayersAppearOnlyWhenSwitchedOn) {
   EXPECT_FALSE(black(pixel(canvas, 4, 2)));
   EXPECT_FALSE(black(pixel(canvas, 2, 12)));
   EXPECT_TRUE(black(pixel(canvas, 2, 2)));
+}
+
+TEST(RenderScene, AWholeLinesMotionIsAnOrangeArrowWhereItMovesAndTheLayerHidesIt) {
+  // Drawn left to right, moving up the image at 80 px/s: an arrow from (15, 20) to (15, 12).
+  TrackedLine moving{.id = 3, .segment = {Point2(5, 20.5f), Point2(25, 20.5f)}, .status = LineStatus::GoodTrack};
+  moving.normal_velocity = -80;
+  const std::vector<TrackedLine> lines = {moving};
+  RenderOptions options;
+  options.show_whole_line_ids = false;
+  cv::Mat canvas(kSensor.height, kSensor.width, CV_8UC3, cv::Scalar(0, 0, 0));
+  draw_whole_lines(lines, options, canvas);
+  const auto orange = [](const cv::Vec3b& p) { return p[2] > 150 && p[0] < 100; };  // BGR; cyan is blue
+  EXPECT_TRUE(orange(pixel(canvas, 15, 15))) << pixel(canvas, 15, 15);
+  EXPECT_TRUE(black(pixel(canvas, 15, 25)));  // nothing on the side it leaves
+  canvas.setTo(cv::Scalar(0, 0, 0));
+  options.show_motion = false;
+  draw_whole_lines(lines, options, canvas);
+  EXPECT_TRUE(black(pixel(canvas, 15, 15)));
+  EXPECT_FALSE(black(pixel(canvas, 15, 20)));  // the line itself
 }
 
 // The viz's status fields at a 240x180 sensor drawn at scale 1: wrapped, every line fits the

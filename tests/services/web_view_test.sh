@@ -81,7 +81,7 @@ check "the screenshot is not blank" test "${distinct:-0}" -gt 100
 check "the screenshot shows whole lines" test "${cyan:-0}" -gt 300
 check "the page's status text came from the viz" grep -qP 'cam0  t=[0-9.]+ s  [0-9.]+ Mev/s  [0-9]+ lines  [1-9][0-9]* whole' "$work/page.html"
 check "the page's status text has the lines service's rates" grep -qP 'detect [0-9]+ Hz  track [0-9]+ Hz  latency' "$work/page.html"
-check "the page has a button per layer" test "$(grep -oP '<button[^>]*>[a-z] [a-z -]+</button>' "$work/page.html" | wc -l)" -eq 7
+check "the page has a button per layer" test "$(grep -oP '<button[^>]*>[a-z] [a-z -]+</button>' "$work/page.html" | wc -l)" -eq 8
 check "the whole lines' button shows them on" grep -qP '<button class="on">w whole lines</button>' "$work/page.html"
 
 # With the stalled client still waiting, the viz goes on drawing and others get pictures.

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <lcm/lcm-cpp.hpp>
 #include <random>
 #include <thread>
@@ -80,6 +82,8 @@ segment_list_t make_list() {
   a.admin_block = 17;
   a.first_seen_us = 100;
   a.last_good_us = 900;
+  a.normal_velocity = -123.5F;
+  a.normal_velocity_std = 7.25F;
   TrackedLine b = a;
   b.id = 43;
   b.status = LineStatus::BadTrack;
@@ -161,6 +165,45 @@ TEST(Messages, SegmentListRoundTripKeepsEveryField) {
   EXPECT_EQ(lines[1].status, LineStatus::BadTrack);
   EXPECT_EQ(lines[0].admin_block, 17);
   EXPECT_EQ(lines[0].last_good_us, 900);
+  EXPECT_FLOAT_EQ(lines[0].normal_velocity, -123.5F);
+  EXPECT_FLOAT_EQ(lines[0].normal_velocity_std, 7.25F);
+}
+
+TEST(Messages, ASegmentWithoutAFiniteVelocityOrWithANegativeDeviationIsRefused) {
+  for (const auto& [velocity, deviation] : {std::pair(std::numeric_limits<float>::quiet_NaN(), 1.0f),
+                                            std::pair(std::numeric_limits<float>::infinity(), 1.0f), std::pair(5.0f, -1.0f)}) {
+    segment_list_t msg = make_list();
+    msg.segments[1].normal_velocity = velocity;
+    msg.segments[1].normal_velocity_std = deviation;
+    std::vector<TrackedLine> lines;
+    EXPECT_FALSE(read_segment_list(msg, lines));
+    EXPECT_TRUE(lines.empty());
+  }
+}
+
+// A segment list as evldt encoded it before line_segment_t carried the velocity (bytes written by
+// that build's lcm-gen types): its fingerprint is another type's. Every consumer counts it as
+// invalid; none crashes. An older consumer refuses today's lists the same way (LCM checks the
+// fingerprint before any field).
+TEST(Messages, ASegmentListOfTheTypeBeforeMotionIsRefusedAsAnotherType) {
+  std::ifstream in(std::string(EVLDT_SOURCE_DIR) + "/tests/data/lcm/segment_list_before_motion.bin", std::ios::binary);
+  ASSERT_TRUE(in);
+  const Bytes old_bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(old_bytes.size(), 8u);
+  segment_list_t decoded;
+  EXPECT_EQ(decode_message(old_bytes, decoded), WireError::WrongType);
+  // The generated decoder alone (what a plain LCM consumer calls) refuses it too.
+  EXPECT_LT(decoded.decode(old_bytes.data(), 0, static_cast<int>(old_bytes.size())), 0);
+  // The consumer SDK counts it as undecodable.
+  lcm::LCM bus("memq://");
+  ASSERT_TRUE(bus.good());
+  int lists = 0;
+  client::LineSubscriber subscriber(bus, "cam0", [&](const client::LineList&) { ++lists; });
+  bus.publish("LINES_CAM0", old_bytes.data(), static_cast<unsigned>(old_bytes.size()));
+  bus.publish("WHOLE_LINES_CAM0", old_bytes.data(), static_cast<unsigned>(old_bytes.size()));
+  for (int k = 0; k < 3; ++k) bus.handleTimeout(50);
+  EXPECT_EQ(lists, 0);
+  EXPECT_EQ(subscriber.undecodable(), 2u);
 }
 
 TEST(Messages, StatsRoundTrip) {
@@ -1166,6 +1209,8 @@ TEST(LineSubscriber, HandsOverSegmentsAndWholeLinesAsPlainStructsAndCountsWhatDo
   segment.y1 = 40.75f;
   segment.score = 0.8f;
   segment.status = line_segment_t::STATUS_GOOD_TRACK;
+  segment.normal_velocity = 55.5f;
+  segment.normal_velocity_std = 3.0f;
   list.segments = {segment};
   list.num_segments = 1;
   bus.publish("LINES_CAM0", &list);
@@ -1187,6 +1232,8 @@ TEST(LineSubscriber, HandsOverSegmentsAndWholeLinesAsPlainStructsAndCountsWhatDo
   EXPECT_EQ(line.x0, 1.5f);
   EXPECT_EQ(line.y1, 40.75f);
   EXPECT_EQ(line.status, client::LineStatus::GoodTrack);
+  EXPECT_EQ(line.normal_velocity, 55.5f);
+  EXPECT_EQ(line.normal_velocity_std, 3.0f);
   EXPECT_TRUE(received[1].whole_lines);
   EXPECT_TRUE(received[1].lines.empty());
   EXPECT_EQ(subscriber.undecodable(), 1u);

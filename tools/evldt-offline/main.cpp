@@ -152,7 +152,8 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
 
 int main(int argc, char** argv) {
   CLI::App app{"evldt-offline: detect and track line segments in an event recording or a built-in scene, deterministically.\n"
-               "Writes the segments over time as CSV (t_us,id,x0,y0,x1,y1,score,status) and prints a summary.\n"
+               "Writes the segments over time as CSV (t_us,id,x0,y0,x1,y1,score,status,normal_velocity,normal_velocity_std)\n"
+               "and prints a summary.\n"
                "Exit status: 0 done, 1 bad usage or configuration, 2 corrupt input (events before the fault processed)."};
   Options options;
   PipelineOptions pipeline_options;

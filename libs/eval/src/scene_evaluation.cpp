@@ -234,15 +234,20 @@ StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthS
   StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth), hold_us);
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted;
+  std::vector<float> velocities;
   for (std::size_t i = 0; i < rows.size();) {
     const Timestamp t = rows[i].t_us;
     ids.clear();
     predicted.clear();
+    velocities.clear();
+    bool any_velocity = false;
     for (; i < rows.size() && rows[i].t_us == t; ++i) {
       ids.push_back(rows[i].id);
       predicted.push_back(rows[i].segment);
+      velocities.push_back(rows[i].normal_velocity);
+      any_velocity = any_velocity || std::isfinite(rows[i].normal_velocity);
     }
-    evaluator.add_prediction(t, ids, predicted);
+    evaluator.add_prediction(t, ids, predicted, any_velocity ? std::span<const float>(velocities) : std::span<const float>());
   }
   evaluator.finish();
   return evaluator;

@@ -1,5 +1,6 @@
 #include "evldt/events/csv_file.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <stdexcept>
 
@@ -30,20 +31,33 @@ void CsvOutput::close() {
 
 void read_csv_rows(const std::filesystem::path& path, std::string_view header,
                    const std::function<void(const std::string& row)>& parse_row) {
+  const std::string_view headers[] = {header};
+  read_csv_rows(path, headers, [&](std::size_t, const std::string& row) { parse_row(row); });
+}
+
+void read_csv_rows(const std::filesystem::path& path, std::span<const std::string_view> headers,
+                   const std::function<void(std::size_t header, const std::string& row)>& parse_row) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot open " + path.string());
   std::string line;
-  std::size_t number = 0;
+  std::size_t number = 0, header = 0;
   while (std::getline(in, line)) {
     ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (number == 1) {
-      if (line != header) throw std::runtime_error(path.string() + ":1: expected the header '" + std::string(header) + "'");
+      header = static_cast<std::size_t>(std::find(headers.begin(), headers.end(), line) - headers.begin());
+      if (header == headers.size()) {
+        std::string message = path.string() + ":1: expected the header";
+        for (std::size_t i = 0; i < headers.size(); ++i) {
+          message.append(i == 0 ? " '" : " or '").append(headers[i]).append("'");
+        }
+        throw std::runtime_error(message);
+      }
       continue;
     }
     if (line.empty()) continue;
     try {
-      parse_row(line);
+      parse_row(header, line);
     } catch (const std::exception& e) {
       throw std::runtime_error(path.string() + ":" + std::to_string(number) + ": " + e.what());
     }

@@ -5,6 +5,7 @@
 #include <array>
 
 #include "evldt/json/json_writer.hpp"
+#include "evldt/lines/normal_motion.hpp"
 
 namespace evldt {
 namespace {
@@ -21,6 +22,7 @@ std::string colour_json(const double (&rgba)[4]) {
 constexpr double kDetected[4] = {1.0, 0.86, 0.0, 1}, kGood[4] = {0.24, 0.86, 0.31, 1}, kBad[4] = {0.9, 0.16, 0.16, 1};
 constexpr double kTransparent[4] = {0, 0, 0, 0};
 constexpr double kTextBackground[4] = {0, 0, 0, 0.5};
+constexpr double kMotion[4] = {1.0, 0.55, 0.0, 1};  // orange, as evldt-viz draws it
 
 // Shared by the schemas below.
 constexpr const char* kTimeSchema = R"({"type": "object", "properties": {"sec": {"type": "integer", "minimum": 0}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999}}, "required": ["sec", "nsec"]})";
@@ -118,19 +120,23 @@ std::string image_annotations_json(std::uint64_t time_ns, std::span<const Tracke
     const double (*colour)[4];
     std::string points;
   };
-  std::array<Group, 3> groups{{{&kDetected, {}}, {&kGood, {}}, {&kBad, {}}}};
+  std::array<Group, 4> groups{{{&kDetected, {}}, {&kGood, {}}, {&kBad, {}}, {&kMotion, {}}}};
   if (!style.by_status) groups[0].colour = &style.colour;
+  const auto add_segment = [&](Group& group, const Segment& segment) {
+    group.points += fmt::format(R"({}{{"x": {:.2f}, "y": {:.2f}}}, {{"x": {:.2f}, "y": {:.2f}}})", group.points.empty() ? "" : ", ",
+                                segment.q0.x() * s, segment.q0.y() * s, segment.q1.x() * s, segment.q1.y() * s);
+  };
   std::string texts;
   for (const TrackedLine& line : lines) {
     Group& group = style.by_status ? groups[static_cast<std::size_t>(line.status)] : groups[0];
-    const Segment& segment = line.segment;
-    group.points += fmt::format(R"({}{{"x": {:.2f}, "y": {:.2f}}}, {{"x": {:.2f}, "y": {:.2f}}})", group.points.empty() ? "" : ", ",
-                                segment.q0.x() * s, segment.q0.y() * s, segment.q1.x() * s, segment.q1.y() * s);
+    add_segment(group, line.segment);
+    if (style.motion) add_segment(groups[3], motion_arrow(line.segment, line.normal_velocity));
     if (style.ids) {
-      const Point2 centre = segment.centre();
+      const Point2 centre = line.segment.centre();
+      const std::string text = style.motion ? fmt::format("{} {:.0f} px/s", line.id, line.normal_velocity) : std::to_string(line.id);
       texts += fmt::format(R"({}{{"timestamp": {}, "position": {{"x": {:.2f}, "y": {:.2f}}}, "text": "{}", "font_size": {}, )"
                            R"("text_color": {}, "background_color": {}}})",
-                           texts.empty() ? "" : ", ", time, centre.x() * s + 3, centre.y() * s, line.id, 10 * scale, colour_json(*group.colour),
+                           texts.empty() ? "" : ", ", time, centre.x() * s + 3, centre.y() * s, text, 10 * scale, colour_json(*group.colour),
                            colour_json(kTextBackground));
     }
   }

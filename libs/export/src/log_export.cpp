@@ -74,7 +74,7 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
   stats_t stats;
   camera_info_t info;
   const AnnotationStyle segment_style{.thickness = 1, .by_status = true};
-  const AnnotationStyle whole_line_style{.thickness = 2, .by_status = false, .ids = true};
+  const AnnotationStyle whole_line_style{.thickness = 2, .by_status = false, .ids = true, .motion = true};
   bool any_batch = false;
   while (log.next(record)) {
     const LcmLogReader::Record* event = &record;

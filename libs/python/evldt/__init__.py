@@ -136,13 +136,15 @@ class Pipeline:
 
 def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), output_period_us=0):
     """evldt-eval's figures for predicted segments (SEGMENT_DTYPE, or any structured array with t,
-    id, x0, y0, x1, y1) against ground truth (GROUND_TRUTH_DTYPE: t, gt_id, x0, y0, x1, y1):
+    id, x0, y0, x1, y1, and normal_velocity if known) against ground truth (GROUND_TRUTH_DTYPE: t, gt_id, x0, y0, x1, y1):
     precision, recall and F at each tolerance (a fraction of the image diagonal), id lifetimes and
     the tracking metrics; vel_err_med and vel_rel_med compare normal velocities (None: the rows
     carry none). output_period_us 0: the median spacing of the predicted steps."""
     predicted = np.zeros(len(segments), dtype=SEGMENT_DTYPE)
     for field in ("t", "id", "x0", "y0", "x1", "y1"):
         predicted[field] = segments[field]
+    for field in ("normal_velocity", "normal_velocity_std"):
+        predicted[field] = segments[field] if field in segments.dtype.names else np.nan
     truth = np.zeros(len(ground_truth), dtype=GROUND_TRUTH_DTYPE)
     for field in GROUND_TRUTH_DTYPE.names:
         truth[field] = ground_truth[field]

@@ -54,6 +54,8 @@ struct SegmentRecord {
   std::uint8_t status;  ///< 0 detected, 1 good, 2 bad (evldt.STATUS_NAMES)
   std::int64_t first_seen;
   std::int64_t last_good;
+  float normal_velocity;  ///< px/s across the line (TrackedLine's); NaN where not known
+  float normal_velocity_std;
 };
 
 /// One ground-truth edge piece at one step (evldt.GROUND_TRUTH_DTYPE), as evldt-sim's CSV has it.
@@ -101,7 +103,8 @@ void append_lines(Timestamp t, std::span<const TrackedLine> lines, std::vector<S
   const std::size_t first = out.size();
   for (const TrackedLine& line : lines) {
     out.push_back({t, line.id, line.segment.q0.x(), line.segment.q0.y(), line.segment.q1.x(), line.segment.q1.y(),
-                   line.score, static_cast<std::uint8_t>(line.status), line.first_seen_us, line.last_good_us});
+                   line.score, static_cast<std::uint8_t>(line.status), line.first_seen_us, line.last_good_us,
+                   line.normal_velocity, line.normal_velocity_std});
   }
   std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(),
             [](const SegmentRecord& a, const SegmentRecord& b) { return a.id < b.id; });
@@ -284,7 +287,8 @@ py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<
   rows.reserve(static_cast<std::size_t>(predicted.shape(0)));
   for (py::ssize_t i = 0; i < predicted.shape(0); ++i) {
     const SegmentRecord& r = predicted(i);
-    rows.push_back({r.t, r.id, Segment{Point2(r.x0, r.y0), Point2(r.x1, r.y1)}, r.score, static_cast<LineStatus>(r.status)});
+    rows.push_back({r.t, r.id, Segment{Point2(r.x0, r.y0), Point2(r.x1, r.y1)}, r.score, static_cast<LineStatus>(r.status),
+                    r.normal_velocity, r.normal_velocity_std});
   }
   std::vector<GroundTruthRow> truth_rows;
   const auto truth = ground_truth.unchecked<1>();
@@ -389,7 +393,7 @@ class Subscriber {
     for (std::size_t i = 0; i < list.lines.size(); ++i) {
       const client::Line& l = list.lines[i];
       out(static_cast<py::ssize_t>(i)) = {list.t_us, static_cast<std::uint64_t>(l.id), l.x0, l.y0, l.x1, l.y1, l.score,
-                                          static_cast<std::uint8_t>(l.status), 0, 0};
+                                          static_cast<std::uint8_t>(l.status), 0, 0, l.normal_velocity, l.normal_velocity_std};
     }
     return py::make_tuple(list.whole_lines, list.camera, list.t_us, lines);
   }
@@ -409,7 +413,8 @@ PYBIND11_MODULE(_evldt, m) {
   using namespace evldt::python;
   m.doc() = "evldt core: recording readers, the deterministic line pipeline, the evaluator and the simulator";
   PYBIND11_NUMPY_DTYPE(EventRecord, t, x, y, p);
-  PYBIND11_NUMPY_DTYPE(SegmentRecord, t, id, x0, y0, x1, y1, score, status, first_seen, last_good);
+  PYBIND11_NUMPY_DTYPE(SegmentRecord, t, id, x0, y0, x1, y1, score, status, first_seen, last_good, normal_velocity,
+                       normal_velocity_std);
   PYBIND11_NUMPY_DTYPE(GroundTruthRecord, t, gt_id, x0, y0, x1, y1);
   // A corrupt recording: what the tools print as the error, after the valid prefix was returned.
   py::register_exception<FormatError>(m, "FormatError", PyExc_ValueError);

@@ -4,6 +4,8 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "evldt/lines/normal_motion.hpp"
+
 namespace evldt {
 
 namespace {
@@ -103,9 +105,14 @@ void draw_whole_lines(std::span<const TrackedLine> lines, const RenderOptions& o
                       std::span<const std::uint32_t> labels) {
   if (!options.show_whole_lines) return;
   const int scale = std::max(1, options.scale);
-  const cv::Scalar cyan(230, 210, 40);
+  const cv::Scalar cyan(230, 210, 40), orange(0, 140, 255);
   for (std::size_t i = 0; i < lines.size(); ++i) {
     draw_labelled(canvas, lines[i], cyan, std::max(2, scale), scale, options.show_whole_line_ids, i < labels.size() ? labels[i] : lines[i].id);
+    if (!options.show_motion) continue;
+    const Segment arrow = motion_arrow(lines[i].segment, lines[i].normal_velocity);
+    if (!((arrow.q1 - arrow.q0).norm() >= 1.0f)) continue;  // still, or not known
+    const auto at = [&](Point2 p) { return cv::Point2f(p.x() * static_cast<float>(scale), p.y() * static_cast<float>(scale)); };
+    cv::arrowedLine(canvas, at(arrow.q0), at(arrow.q1), orange, std::max(1, scale / 2), cv::LINE_AA, 0, 0.3);
   }
 }
 

@@ -86,7 +86,7 @@ std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std:
     step_t = msg.t_us;
     std::sort(lines.begin(), lines.end(), [](const TrackedLine& a, const TrackedLine& b) { return a.id < b.id; });
     for (const TrackedLine& line : lines) {
-      rows.push_back({msg.t_us, line.id, line.segment, line.score, line.status});
+      rows.push_back({msg.t_us, line.id, line.segment, line.score, line.status, line.normal_velocity, line.normal_velocity_std});
     }
   }
   log.report();

@@ -70,7 +70,7 @@ class WireWalker {
 };
 
 // Encoded sizes of the fixed parts (see the .lcm files).
-constexpr std::size_t kSegmentWireBytes = 8 + 5 * 4 + 1 + 4 + 8 + 8;
+constexpr std::size_t kSegmentWireBytes = 8 + 5 * 4 + 1 + 4 + 8 + 8 + 2 * 4;
 constexpr std::size_t kStatsMiddleBytes =
     8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 4 + 2 * 8 + 2 * 8 + 8 + 4 + 2 * 4 + 8;  // period_s .. reconnects
 
@@ -319,6 +319,8 @@ void fill_segment_list(std::span<const TrackedLine> lines, segment_list_t& msg) 
     out.admin_block = line.admin_block;
     out.first_seen_us = line.first_seen_us;
     out.last_good_us = line.last_good_us;
+    out.normal_velocity = line.normal_velocity;
+    out.normal_velocity_std = line.normal_velocity_std;
   }
 }
 
@@ -328,8 +330,9 @@ bool read_segment_list(const segment_list_t& msg, std::vector<TrackedLine>& out)
                 static_cast<int>(LineStatus::BadTrack) == line_segment_t::STATUS_BAD_TRACK);
   out.clear();
   for (const line_segment_t& in : msg.segments) {
-    const bool finite = std::isfinite(in.x0) && std::isfinite(in.y0) && std::isfinite(in.x1) &&
-                        std::isfinite(in.y1) && std::isfinite(in.score);
+    const bool finite = std::isfinite(in.x0) && std::isfinite(in.y0) && std::isfinite(in.x1) && std::isfinite(in.y1) &&
+                        std::isfinite(in.score) && std::isfinite(in.normal_velocity) &&
+                        std::isfinite(in.normal_velocity_std) && in.normal_velocity_std >= 0;
     if (!finite || in.status < line_segment_t::STATUS_DETECTED || in.status > line_segment_t::STATUS_BAD_TRACK) {
       out.clear();
       return false;
@@ -342,6 +345,8 @@ bool read_segment_list(const segment_list_t& msg, std::vector<TrackedLine>& out)
     line.admin_block = in.admin_block;
     line.first_seen_us = in.first_seen_us;
     line.last_good_us = in.last_good_us;
+    line.normal_velocity = in.normal_velocity;
+    line.normal_velocity_std = in.normal_velocity_std;
   }
   return true;
 }

@@ -33,6 +33,9 @@ struct Line {
   float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   float score = 0;      ///< fitting score
   LineStatus status = LineStatus::Detected;
+  /// px/s across itself, along (-(y1 - y0), x1 - x0) / length (for a line drawn left to right,
+  /// positive is down the image), and the standard deviation of that estimate.
+  float normal_velocity = 0, normal_velocity_std = 0;
 };
 
 /// The lines of one camera at one lattice state.
@@ -84,7 +87,8 @@ class LineSubscriber {
     list.newest_batch_utime = message.newest_batch_utime;
     list.lines.reserve(message.segments.size());
     for (const line_segment_t& s : message.segments) {
-      list.lines.push_back({s.id, s.x0, s.y0, s.x1, s.y1, s.score, static_cast<LineStatus>(s.status)});
+      list.lines.push_back({s.id, s.x0, s.y0, s.x1, s.y1, s.score, static_cast<LineStatus>(s.status), s.normal_velocity,
+                            s.normal_velocity_std});
     }
     handler_(list);
   }

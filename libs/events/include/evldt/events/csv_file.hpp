@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -31,5 +32,9 @@ class CsvOutput {
 /// parse_row, or a wrong header, becomes std::runtime_error "path:line: what".
 void read_csv_rows(const std::filesystem::path& path, std::string_view header,
                    const std::function<void(const std::string& row)>& parse_row);
+/// As above for a file that may have any of `headers` (a format that grew columns); parse_row is
+/// told which one the file has (its index).
+void read_csv_rows(const std::filesystem::path& path, std::span<const std::string_view> headers,
+                   const std::function<void(std::size_t header, const std::string& row)>& parse_row);
 
 }  // namespace evldt

@@ -31,6 +31,8 @@ struct AnnotationStyle {
   bool by_status = true;  ///< segments: colour by status (yellow detected, green good, red bad); else `colour`
   double colour[4] = {0.16, 0.82, 0.90, 1};  ///< r, g, b, a in 0..1 (whole lines: cyan)
   bool ids = false;                          ///< a text with each line's id at its centre
+  /// Each line's motion: an arrow (motion_arrow, orange) and, with ids, its normal velocity in the text.
+  bool motion = false;
 };
 /// Lines as line lists (one per colour) and, with style.ids, their ids; coordinates times `scale`.
 std::string image_annotations_json(std::uint64_t time_ns, std::span<const TrackedLine> lines, const AnnotationStyle& style, int scale);

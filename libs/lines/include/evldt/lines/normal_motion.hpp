@@ -47,6 +47,15 @@ struct NormalMotion {
 /// The unit normal of a segment q0 -> q1, (0, 0) for a point.
 [[nodiscard]] Point2 unit_normal(const Segment& segment);
 
+/// How far ahead a drawn motion arrow looks: it spans where the line's middle goes in this time.
+inline constexpr float kMotionArrowSeconds = 0.1f;
+/// The arrow drawn for a line's motion: from its middle to where that moves in kMotionArrowSeconds
+/// at `normal_velocity` (a point for a still line).
+[[nodiscard]] inline Segment motion_arrow(const Segment& line, float normal_velocity) {
+  const Point2 from = line.centre();
+  return {from, from + unit_normal(line) * (normal_velocity * kMotionArrowSeconds)};
+}
+
 /// Starts the estimate at a line's first position, with no velocity known (started = true).
 void start_motion(NormalMotion& motion, const Segment& segment, Timestamp t_us, const MotionParams& params);
 /// One observation of the line at t_us (after the last): `segment` gives its direction, `at` a point

@@ -1,8 +1,11 @@
 #pragma once
-// Segments over time as CSV: "t_us,id,x0,y0,x1,y1,score,status", one row per live segment per
-// output step, rows of a step sorted by id. Coordinates are continuous image coordinates.
+// Segments over time as CSV: "t_us,id,x0,y0,x1,y1,score,status,normal_velocity,normal_velocity_std",
+// one row per live segment per output step, rows of a step sorted by id. Coordinates are continuous
+// image coordinates; velocities px/s (TrackedLine's). Files without the two velocity columns, as
+// evldt wrote them before it estimated motion, are read too.
 
 #include <filesystem>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -11,7 +14,9 @@
 
 namespace evldt {
 
-inline constexpr const char* kSegmentCsvHeader = "t_us,id,x0,y0,x1,y1,score,status";
+inline constexpr const char* kSegmentCsvHeader = "t_us,id,x0,y0,x1,y1,score,status,normal_velocity,normal_velocity_std";
+/// The header of a file without velocities.
+inline constexpr const char* kSegmentCsvHeaderWithoutVelocity = "t_us,id,x0,y0,x1,y1,score,status";
 
 class SegmentCsvWriter {
  public:
@@ -35,6 +40,8 @@ struct SegmentRow {
   Segment segment;
   float score = 0;
   LineStatus status = LineStatus::Detected;
+  float normal_velocity = std::numeric_limits<float>::quiet_NaN();  ///< NaN: not known
+  float normal_velocity_std = std::numeric_limits<float>::quiet_NaN();
 };
 
 /// Reads a whole segment CSV; throws std::runtime_error naming the file and line on malformed input.

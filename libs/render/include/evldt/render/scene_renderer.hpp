@@ -22,6 +22,7 @@ struct RenderOptions {
   bool show_bad_tracks = true;        ///< segments whose last track scored below the threshold
   bool show_whole_lines = true;       ///< whole lines (draw_whole_lines), over the segments
   bool show_whole_line_ids = true;    ///< each whole line's label beside it
+  bool show_motion = true;            ///< each whole line's motion across itself, an arrow (motion_arrow)
   bool show_segment_ids = false;      ///< each segment's label beside it
   bool show_grid = false;             ///< the lattice's block borders
   int grid_block_size = 0;            ///< spacing of the grid (b); 0: no grid
@@ -33,11 +34,12 @@ struct Layer {
   const char* name;
   bool RenderOptions::*shown;
 };
-inline constexpr std::array<Layer, 7> kLayers{{{'e', "events", &RenderOptions::show_events},
+inline constexpr std::array<Layer, 8> kLayers{{{'e', "events", &RenderOptions::show_events},
                                                {'s', "segments", &RenderOptions::show_segments},
                                                {'b', "bad tracks", &RenderOptions::show_bad_tracks},
                                                {'w', "whole lines", &RenderOptions::show_whole_lines},
                                                {'i', "whole-line ids", &RenderOptions::show_whole_line_ids},
+                                               {'m', "motion", &RenderOptions::show_motion},
                                                {'n', "segment ids", &RenderOptions::show_segment_ids},
                                                {'g', "block grid", &RenderOptions::show_grid}}};
 /// The layer of a key, or null.
@@ -57,7 +59,9 @@ void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std
                   const RenderOptions& options, cv::Mat& canvas, std::span<const std::uint32_t> labels = {});
 
 /// Draws whole lines (cyan, thicker than segments) on a canvas render_scene drew, if
-/// options.show_whole_lines; with show_whole_line_ids, `labels` (one per line; empty: the ids) beside them.
+/// options.show_whole_lines; with show_whole_line_ids, `labels` (one per line; empty: the ids) beside
+/// them; with show_motion, an orange arrow from each one's middle to where it moves in
+/// kMotionArrowSeconds.
 void draw_whole_lines(std::span<const TrackedLine> lines, const RenderOptions& options, cv::Mat& canvas,
                       std::span<const std::uint32_t> labels = {});
 

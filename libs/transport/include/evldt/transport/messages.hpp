@@ -57,7 +57,8 @@ WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_b
 void fill_segment_list(std::span<const TrackedLine> lines, segment_list_t& msg);
 /// The camera fields of a CAMERA_INFO message (utime, epoch and source are the caller's).
 void fill_camera_info(const RectificationTable& table, camera_info_t& msg);
-/// Replaces `out` with the segments of `msg`; false if any has an unknown status or a non-finite value.
+/// Replaces `out` with the segments of `msg`; false if any has an unknown status, a non-finite value
+/// or a negative velocity deviation.
 bool read_segment_list(const segment_list_t& msg, std::vector<TrackedLine>& out);
 
 }  // namespace evldt
