@@ -306,5 +306,48 @@ TEST(Scenes, AGroundTruthIdFollowsOneEdgeThroughOcclusionAndClippingForTenSecond
   }
 }
 
+// --occlude-ms: a bar crosses the image and back once a second, hiding a point at the middle for
+// the time asked; it is ground truth itself, and splits the edges it covers.
+TEST(Scenes, AnOccluderHidesAnEdgeAtTheMiddleForAboutTheTimeAsked) {
+  // One still horizontal edge across the image: the top of a wide box.
+  Scene scene{"edge", {240, 180}, 0.8, {}, {}, 2'000'000};
+  Shape box;
+  box.polygon = {{-20, 90}, {260, 90}, {260, 300}, {-20, 300}};
+  box.brightness = 0.2;
+  scene.shapes.push_back(box);
+  const Scene occluded = with_occluder(scene, 100'000);
+  EXPECT_EQ(occluded.name, "edge/o100");
+  ASSERT_EQ(occluded.shapes.size(), 2u);
+  EXPECT_EQ(with_occluder(scene, 0).shapes.size(), 1u);
+  EXPECT_THROW(with_occluder(scene, 400'000), std::invalid_argument);
+  // How long the edge's point at the middle (x = 120) is hidden, in 1 ms steps, and into how many
+  // pieces the bar cuts the edge meanwhile.
+  const int edge_id = 0;  // shape 0, edge 0: the top
+  Timestamp hidden_us = 0;
+  std::size_t most_pieces = 0;
+  for (Timestamp t = 0; t <= 1'000'000; t += 1000) {
+    bool covered = true;
+    std::size_t pieces = 0;
+    for (const GtSegment& g : occluded.visible_edges(t)) {
+      if (g.gt_id != edge_id) continue;
+      ++pieces;
+      if (std::min(g.a.x(), g.b.x()) <= 120 && std::max(g.a.x(), g.b.x()) >= 120) covered = false;
+    }
+    if (covered) hidden_us += 1000;
+    most_pieces = std::max(most_pieces, pieces);
+  }
+  EXPECT_NEAR(static_cast<double>(hidden_us), 100'000.0, 5'000.0);
+  EXPECT_EQ(most_pieces, 2u);
+  // Before it enters and once it has left, the edge is whole; the bar's own edges are ground truth.
+  EXPECT_EQ(occluded.visible_edges(0).size(), scene.visible_edges(0).size());
+  const auto bar_edges = [&](Timestamp t) {
+    std::size_t n = 0;
+    for (const GtSegment& g : occluded.visible_edges(t)) n += g.gt_id / 64 == 1 ? 1 : 0;
+    return n;
+  };
+  EXPECT_EQ(bar_edges(0), 0u);
+  EXPECT_EQ(bar_edges(500'000), 2u);
+}
+
 }  // namespace
 }  // namespace evldt

@@ -21,6 +21,11 @@ void SimulatorOptions::add_to(CLI::App& app, bool scene_required) {
                     "Another recording of the scene: new phases, amplitudes and frequencies of the camera motion "
                     "(0: the scene's own)")
       ->capture_default_str();
+  group->add_option("--occlude-ms", occlude_ms_,
+                    "A bar in front of the scene sweeps across the image once a second and back, hiding each edge it "
+                    "passes for about this long (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 300));
   group->add_option("--contrast", contrast_, "Contrast threshold C+ = C- (log intensity; default 0.2)")
       ->check(finite_number() & CLI::Range(0.01, 5.0));
   group->add_option("--contrast-sigma", contrast_sigma_, "Per-pixel threshold spread (std dev; default 0.03, the scene's own)")
@@ -69,7 +74,7 @@ SimulatorConfig SimulatorOptions::config() const {
 Scene SimulatorOptions::scene() const {
   Scene s = vary_camera_motion(make_scene(scene_), motion_seed_);
   if (duration_s_) s.duration_us = static_cast<Timestamp>(std::llround(*duration_s_ * 1e6));
-  return s;
+  return with_occluder(std::move(s), Timestamp{occlude_ms_} * 1000);
 }
 
 }  // namespace evldt

@@ -298,4 +298,28 @@ Scene vary_camera_motion(Scene scene, std::uint64_t seed) {
   return scene;
 }
 
+Scene with_occluder(Scene scene, Timestamp hidden_us) {
+  if (hidden_us <= 0) return scene;
+  // The bar's middle moves as x(t) = w/2 - A cos(pi t): off the image on the left at t = 0 (A = w/2
+  // + width), across it by t = 1 s, at pi A px/s in the image's middle. A point there is hidden for
+  // width / (pi A) = hidden: width = hidden pi (w/2 + width).
+  constexpr double kCrossingsPerSecond = 1.0;
+  const double sweep = std::numbers::pi * kCrossingsPerSecond;  // pi A is the peak speed
+  const double hidden_s = static_cast<double>(hidden_us) * 1e-6, w = scene.sensor.width, h = scene.sensor.height;
+  if (hidden_s * sweep >= 1) {
+    throw std::invalid_argument("an occlusion of " + std::to_string(hidden_us / 1000) + " ms is longer than a bar sweeping "
+                                "once a second can hide anything (at most 318 ms)");
+  }
+  const double width = hidden_s * sweep * (w / 2) / (1 - hidden_s * sweep);
+  Shape bar;
+  // Tall enough to span the image however the camera moves it.
+  bar.polygon = {Vec2d(-width / 2, -h), Vec2d(width / 2, -h), Vec2d(width / 2, 2 * h), Vec2d(-width / 2, 2 * h)};
+  bar.brightness = scene.background > 0.5 ? 0.1 : 0.9;
+  bar.motion.tx = {.base = w / 2, .amplitude = w / 2 + width, .frequency_hz = kCrossingsPerSecond / 2,
+                   .phase = -std::numbers::pi / 2};
+  scene.shapes.push_back(bar);
+  scene.name += "/o" + std::to_string(hidden_us / 1000);
+  return scene;
+}
+
 }  // namespace evldt

@@ -16,8 +16,8 @@ class SimulatorOptions {
   void add_to(CLI::App& app, bool scene_required);
   [[nodiscard]] bool scene_selected() const { return !scene_.empty(); }
   [[nodiscard]] const std::string& scene_name() const { return scene_; }
-  /// The scene with the duration and motion-seed overrides applied; throws std::invalid_argument on
-  /// an unknown name.
+  /// The scene with the duration, motion-seed and occluder overrides applied; throws
+  /// std::invalid_argument on an unknown name.
   [[nodiscard]] Scene scene() const;
   /// The scene's camera model (the default one without a scene), with the flags given applied.
   [[nodiscard]] SimulatorConfig config() const;
@@ -27,6 +27,7 @@ class SimulatorOptions {
   std::optional<double> duration_s_;
   std::uint64_t seed_ = 1;
   std::uint64_t motion_seed_ = 0;
+  int occlude_ms_ = 0;
   std::optional<double> contrast_, contrast_sigma_, noise_rate_hz_, dark_noise_hz_, readout_rate_eps_;
   std::optional<Timestamp> refractory_us_, jitter_us_;
   std::optional<int> hot_pixels_;

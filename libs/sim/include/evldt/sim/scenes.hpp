@@ -24,5 +24,12 @@ SimulatorConfig scene_camera_model(std::string_view name);
 /// The name gets "/m<seed>". For held-out runs: parameters tuned on a scene are scored on its
 /// variants too.
 Scene vary_camera_motion(Scene scene, std::uint64_t seed);
+/// The scene with a bar in front of everything that sweeps across the image and back (one crossing
+/// a second, a sine in time), as a pole or an arm passing the camera: it hides each edge it passes
+/// for about `hidden_us` at the image's middle (its width is made so; longer towards the sides, where
+/// it is slower). Its own vertical edges are ground truth like any other. Throws
+/// std::invalid_argument where no bar hides that long at that speed (hidden_us >= 1 / pi s). The
+/// name gets "/o<ms>".
+Scene with_occluder(Scene scene, Timestamp hidden_us);
 
 }  // namespace evldt
