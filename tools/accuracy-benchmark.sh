@@ -27,7 +27,7 @@ for filters in default none; do
     # A row for the segments and one for the whole lines of the same run.
     while IFS= read -r line; do
       [[ $filters == none ]] && line="${line/$scene/$scene/none}"
-      [[ $line == "whole-line support"* ]] && { echo "$line"; continue; }
+      [[ $line == "whole-line support"* || $line == "id switches"* ]] && { echo "$line"; continue; }
       echo "$line   ${rate} Mev/s"
     done < <(tail -n +2 "$out/$name.txt")
   done
