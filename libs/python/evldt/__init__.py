@@ -210,7 +210,8 @@ class Subscriber:
             print(lines.whole_lines, lines.t_us, lines.lines["id"])
 
     Each list is a LineList: whole_lines (WHOLE_LINES_<CAMERA> or LINES_<CAMERA>), camera, t_us (the
-    lattice state's event time) and lines (SEGMENT_DTYPE; first_seen and last_good are 0)."""
+    lattice state's event time) and lines (SEGMENT_DTYPE; first_seen and last_good are 0, the
+    normal velocities those on the bus)."""
 
     def __init__(self, camera="cam0", url=""):
         self._impl = _evldt.Subscriber(str(camera), str(url))
