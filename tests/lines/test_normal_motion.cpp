@@ -37,19 +37,6 @@ TEST(NormalMotion, ALineDrawnLeftToRightMovingDownHasAPositiveVelocity) {
   EXPECT_NEAR(motion.velocity, -before, 0.1f * before);
 }
 
-TEST(NormalMotion, APredictionMovesTheLineAcrossItselfByVelocityTimesTime) {
-  NormalMotion motion;
-  start_motion(motion, horizontal_at(20), 0, MotionParams{});
-  motion.velocity = 500;
-  const Segment ahead = motion.predict(horizontal_at(20), 10'000);
-  EXPECT_NEAR(ahead.q0.y(), 25.0f, 1e-4f);
-  EXPECT_NEAR(ahead.q1.y(), 25.0f, 1e-4f);
-  EXPECT_FLOAT_EQ(ahead.q0.x(), 10.0f);
-  // Asked of the line drawn the other way round: the same place.
-  const Segment reversed = motion.predict({Point2(40, 20), Point2(10, 20)}, 10'000);
-  EXPECT_NEAR(reversed.q0.y(), 25.0f, 1e-4f);
-}
-
 TEST(NormalMotion, AStillLineSettlesAtZeroAndAPointIsNoObservation) {
   const MotionParams params;
   NormalMotion motion;

@@ -52,7 +52,6 @@ std::uint64_t LineMap::add(const Segment& segment, float score, int admin_block,
   start_motion(motion, segment, now, motion_params_);
   // The edge's motion goes on: the new segment is where the edge is now, moving as it did.
   const auto take_velocity = [&](const NormalMotion& edge) {
-    if (!edge.started) return;
     motion.velocity = unit_normal(segment).dot(edge.normal) < 0 ? -edge.velocity : edge.velocity;
     motion.var_velocity = edge.var_velocity;
   };
@@ -120,7 +119,7 @@ const NormalMotion* LineMap::neighbour_motion(const Segment& segment, int block)
       if (owner < 0) continue;
       const auto index = static_cast<std::size_t>(owner);
       const float offset = offset_along(lines_[index].segment, direction, centre);
-      if (!motion_[index].started || offset > max_offset || (best != nullptr && offset >= best_offset)) continue;
+      if (offset > max_offset || (best != nullptr && offset >= best_offset)) continue;
       best = &motion_[index];
       best_offset = offset;
     }

@@ -13,13 +13,6 @@ Point2 unit_normal(const Segment& segment) {
   return Point2(-along.y(), along.x()) / length;
 }
 
-Segment NormalMotion::predict(const Segment& segment, Timestamp dt_us) const {
-  Point2 n = unit_normal(segment);
-  if (n.dot(normal) < 0) n = -n;
-  const Point2 shift = n * static_cast<float>(velocity * static_cast<double>(dt_us) * kSecondsPerUs);
-  return {segment.q0 + shift, segment.q1 + shift};
-}
-
 void start_motion(NormalMotion& motion, const Segment& segment, Timestamp t_us, const MotionParams& params) {
   const float position_var = params.position_std_px * params.position_std_px;
   motion = {.anchor = segment.centre(),

@@ -60,8 +60,6 @@ class LineMap {
   /// the segment along its normal by the inliers' mean offset): finer than the segment's own place,
   /// whose ends move in steps of dq.
   [[nodiscard]] Point2& band_centre(std::size_t index) { return band_centre_[index]; }
-  /// The estimate of lines()[index]'s motion across itself.
-  [[nodiscard]] const NormalMotion& motion(std::size_t index) const { return motion_[index]; }
   /// Observes where each line's band is after a tracking round at `now` (of those with a good
   /// track: a bad one's place says nothing of its edge) and sets its normal_velocity and
   /// normal_velocity_std.
@@ -124,7 +122,7 @@ class LineMap {
   std::vector<std::int32_t> owner_;  ///< per block: index into lines_ of the line it administers, or -1
   std::vector<TrackedLine> lines_;
   std::vector<std::uint64_t> settled_;  ///< per line, settled_version()
-  std::vector<NormalMotion> motion_;     ///< per line, motion()
+  std::vector<NormalMotion> motion_;     ///< per line: the estimate of its motion across itself
   std::vector<Point2> band_centre_;      ///< per line, band_centre()
   std::uint64_t first_id_ = 1;
   std::uint64_t next_id_ = 1;

@@ -39,9 +39,6 @@ struct NormalMotion {
   bool started = false;
 
   [[nodiscard]] float velocity_std() const { return std::sqrt(var_velocity); }
-  /// Where the line is predicted `dt_us` after its last observation: `segment` (its last geometry)
-  /// moved across itself by velocity * dt.
-  [[nodiscard]] Segment predict(const Segment& segment, Timestamp dt_us) const;
 };
 
 /// The unit normal of a segment q0 -> q1, (0, 0) for a point.
