@@ -558,20 +558,37 @@ std::vector<std::uint8_t> compress(aedat4::CompressionType compression, const st
   }
 }
 
-/// A DV event packet; without `identifier`, as writers other than DV may leave out its EVTS.
-std::vector<std::uint8_t> dv_event_packet(const EventBatch& events, std::size_t from, std::size_t to, bool identifier = true) {
+/// How a writer lays out its FlatBuffers (the header and the packets).
+enum class FlatBufferLayout {
+  Dv,     ///< as DV writes them: size-prefixed, with identifiers, fields in the schema's order
+  Other,  ///< every field written, in another order, and no identifiers
+  /// as the aedat library writes them: each finished as a plain buffer, its size then put in front,
+  /// so 8-byte fields are aligned from the buffer's first byte, not from the prefix
+  SizeInFront,
+};
+
+/// The builder's buffer as the layout stores it: size-prefixed already, or with its size put in front.
+std::vector<std::uint8_t> stored(const flatbuffers::FlatBufferBuilder& builder, FlatBufferLayout layout) {
+  std::vector<std::uint8_t> bytes;
+  if (layout == FlatBufferLayout::SizeInFront) append_le32(bytes, static_cast<std::uint32_t>(builder.GetSize()));
+  bytes.insert(bytes.end(), builder.GetBufferPointer(), builder.GetBufferPointer() + builder.GetSize());
+  return bytes;
+}
+
+/// A DV event packet of events [from, to).
+std::vector<std::uint8_t> dv_event_packet(const EventBatch& events, std::size_t from, std::size_t to, FlatBufferLayout layout) {
   flatbuffers::FlatBufferBuilder builder;
   std::vector<dv::Event> elements;
   for (std::size_t i = from; i < to; ++i) {
     elements.emplace_back(events.t[i], static_cast<std::int16_t>(events.x[i]), static_cast<std::int16_t>(events.y[i]), events.p[i] > 0);
   }
   const auto packet = dv::CreateEventPacket(builder, builder.CreateVectorOfStructs(elements));
-  if (identifier) {
-    dv::FinishSizePrefixedEventPacketBuffer(builder, packet);
-  } else {
-    builder.FinishSizePrefixed(packet);
+  switch (layout) {
+    case FlatBufferLayout::Dv: dv::FinishSizePrefixedEventPacketBuffer(builder, packet); break;
+    case FlatBufferLayout::Other: builder.FinishSizePrefixed(packet); break;
+    case FlatBufferLayout::SizeInFront: builder.Finish(packet); break;
   }
-  return {builder.GetBufferPointer(), builder.GetBufferPointer() + builder.GetSize()};
+  return stored(builder, layout);
 }
 
 const char* kInfoXml = R"(<dv version="2.0">
@@ -591,31 +608,34 @@ const char* kInfoXml = R"(<dv version="2.0">
     </node>
 </dv>)";
 
-/// How a writer lays out the IOHeader.
-enum class HeaderLayout {
-  Dv,     ///< as DV writes it: size-prefixed, with the identifier "IOHE", fields in the schema's order
-  Other,  ///< as other writers may: every field written, in another order, and no identifiers
-};
-
 /// An AEDAT 4.0 file: the events in packets of `per_packet` on stream 4, an IMU packet (stream 1)
 /// between them. Returns where each packet header starts.
 std::vector<std::uint64_t> write_aedat4(const std::filesystem::path& path, const EventBatch& events, std::size_t per_packet,
-                                        aedat4::CompressionType compression, HeaderLayout layout = HeaderLayout::Dv) {
+                                        aedat4::CompressionType compression, FlatBufferLayout layout = FlatBufferLayout::Dv) {
   std::vector<std::uint8_t> file(kAedat4Magic.begin(), kAedat4Magic.end());
-  flatbuffers::FlatBufferBuilder prefixed;
-  if (layout == HeaderLayout::Dv) {
-    aedat4::FinishSizePrefixedIOHeaderBuffer(prefixed, aedat4::CreateIOHeaderDirect(prefixed, compression, -1, kInfoXml));
-  } else {
-    // The fields added in reverse: the table lists the string first and the compression last.
-    prefixed.ForceDefaults(true);
-    const auto info = prefixed.CreateString(kInfoXml);
-    aedat4::IOHeaderBuilder header(prefixed);
-    header.add_infoNode(info);
-    header.add_dataTablePosition(-1);
-    header.add_compression(compression);
-    prefixed.FinishSizePrefixed(header.Finish());
+  flatbuffers::FlatBufferBuilder header_builder;
+  switch (layout) {
+    case FlatBufferLayout::Dv:
+      aedat4::FinishSizePrefixedIOHeaderBuffer(header_builder, aedat4::CreateIOHeaderDirect(header_builder, compression, -1, kInfoXml));
+      break;
+    case FlatBufferLayout::Other: {
+      // The fields added in reverse: the table lists the string first and the compression last.
+      header_builder.ForceDefaults(true);
+      const auto info = header_builder.CreateString(kInfoXml);
+      aedat4::IOHeaderBuilder header(header_builder);
+      header.add_infoNode(info);
+      header.add_dataTablePosition(-1);
+      header.add_compression(compression);
+      header_builder.FinishSizePrefixed(header.Finish());
+      break;
+    }
+    case FlatBufferLayout::SizeInFront:
+      header_builder.ForceDefaults(true);  // the 8-byte dataTablePosition is written, aligned from the buffer's start
+      header_builder.Finish(aedat4::CreateIOHeaderDirect(header_builder, compression, -1, kInfoXml));
+      break;
   }
-  file.insert(file.end(), prefixed.GetBufferPointer(), prefixed.GetBufferPointer() + prefixed.GetSize());
+  const auto header = stored(header_builder, layout);
+  file.insert(file.end(), header.begin(), header.end());
   std::vector<std::uint64_t> packet_starts;
   auto packet = [&](std::int32_t stream, const std::vector<std::uint8_t>& payload) {
     packet_starts.push_back(file.size());
@@ -625,7 +645,7 @@ std::vector<std::uint64_t> write_aedat4(const std::filesystem::path& path, const
     file.insert(file.end(), compressed.begin(), compressed.end());
   };
   for (std::size_t at = 0; at < events.size(); at += per_packet) {
-    packet(4, dv_event_packet(events, at, std::min(events.size(), at + per_packet), layout == HeaderLayout::Dv));
+    packet(4, dv_event_packet(events, at, std::min(events.size(), at + per_packet), layout));
     packet(1, std::vector<std::uint8_t>(40, 7));  // not events: skipped
   }
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
@@ -650,19 +670,50 @@ TEST(Aedat4, PolarityPacketsInEveryCompressionWithSensorAndCameraFromTheHeader) 
   }
 }
 
-// A header of another writer (issue 49: a clip rewritten by a third-party library was refused):
-// any field order, no file identifier; it reads as DV's.
+// A header of another writer: any field order, no file identifier; it reads as DV's.
 TEST(Aedat4, AHeaderInAnotherFieldOrderWithoutTheIdentifierReadsInEveryCompression) {
   TempDir dir;
   const EventBatch events = sweep_events(1000, 100);
   for (const auto compression : {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
     SCOPED_TRACE(static_cast<int>(compression));
     const auto path = dir.file("other.aedat4");
-    write_aedat4(path, events, 300, compression, HeaderLayout::Other);
+    write_aedat4(path, events, 300, compression, FlatBufferLayout::Other);
     const ReadAll result = read_all(path);
     EXPECT_EQ(result.error, "");
     EXPECT_EQ(result.events, events_of(events));
     EXPECT_EQ(result.sensor, (SensorSize{346, 260}));
+  }
+}
+
+// The aedat library (Python/Rust) finishes each FlatBuffer plain and puts its size in front, so its
+// 8-byte fields sit 4 bytes off the alignment a size-prefixed buffer has: the header, and every event
+// packet, read as DV's do.
+TEST(Aedat4, FlatBuffersWithTheirSizePutInFrontReadAsDvsInEveryCompression) {
+  TempDir dir;
+  const EventBatch events = sweep_events(1000, 100);
+  const auto dv_path = dir.file("dv.aedat4");
+  write_aedat4(dv_path, events, 300, aedat4::CompressionType::LZ4);
+  const ReadAll from_dv = read_all(dv_path);
+  ASSERT_EQ(from_dv.error, "");
+  for (const auto compression : {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
+    SCOPED_TRACE(static_cast<int>(compression));
+    const auto path = dir.file("aedat-library.aedat4");
+    write_aedat4(path, events, 300, compression, FlatBufferLayout::SizeInFront);
+    // The fixture is what real files hold: a verifier aligned from the prefix refuses its header.
+    std::ifstream in(path, std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::uint32_t header_size = 0;
+    std::memcpy(&header_size, bytes.data() + kAedat4Magic.size(), 4);
+    std::vector<std::uint64_t> header((4 + header_size + 7) / 8);
+    std::memcpy(header.data(), bytes.data() + kAedat4Magic.size(), 4 + header_size);
+    EXPECT_FALSE(flatbuffers::Verifier(reinterpret_cast<const std::uint8_t*>(header.data()), 4 + header_size)
+                     .VerifySizePrefixedBuffer<aedat4::IOHeader>(nullptr));
+
+    const ReadAll result = read_all(path);
+    EXPECT_EQ(result.error, "");
+    EXPECT_EQ(result.events, from_dv.events);
+    EXPECT_EQ(result.sensor, from_dv.sensor);
+    EXPECT_EQ(result.name.substr(result.name.find("camera")), from_dv.name.substr(from_dv.name.find("camera")));
   }
 }
 

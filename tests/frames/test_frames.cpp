@@ -531,11 +531,23 @@ TEST_F(FramesTest, Aedat2DavisApsFramesAreResetMinusSignal) {
 
 // ---- AEDAT 4.0 frame streams ----------------------------------------------------------------------
 
+/// How the writer stores each FlatBuffer: size-prefixed as DV does, or finished plain with its size
+/// then put in front, as the aedat library does (8-byte fields aligned from the buffer, not the prefix).
+enum class Writer { Dv, AedatLibrary };
+
+/// The finished builder's bytes as `writer` stores them.
+std::vector<std::uint8_t> stored(const flatbuffers::FlatBufferBuilder& builder, Writer writer) {
+  std::vector<std::uint8_t> bytes;
+  if (writer == Writer::AedatLibrary) put32(bytes, static_cast<std::uint32_t>(builder.GetSize()));
+  bytes.insert(bytes.end(), builder.GetBufferPointer(), builder.GetBufferPointer() + builder.GetSize());
+  return bytes;
+}
+
 /// A frame as DV writes one per FRME packet: built by slot number (as DV's own accessors read them:
 /// timestamp 4, start / end of exposure 10 / 12, format 14, sizeX 16, sizeY 18, pixels 24), not
 /// through evldt's schema, so a slot evldt's schema put elsewhere would fail here.
 std::vector<std::uint8_t> dv_frame(Timestamp t, Timestamp start_exposure, Timestamp end_exposure, std::int8_t format, const cv::Mat& image,
-                                   std::size_t pixels_cut = 0) {
+                                   std::size_t pixels_cut = 0, Writer writer = Writer::Dv) {
   flatbuffers::FlatBufferBuilder builder;
   const cv::Mat continuous = image.clone();
   const auto pixels = builder.CreateVector(continuous.data, continuous.total() * continuous.elemSize() - pixels_cut);
@@ -547,21 +559,31 @@ std::vector<std::uint8_t> dv_frame(Timestamp t, Timestamp start_exposure, Timest
   builder.AddElement<std::int16_t>(16, static_cast<std::int16_t>(image.cols), 0);
   builder.AddElement<std::int16_t>(18, static_cast<std::int16_t>(image.rows), 0);
   builder.AddOffset(24, pixels);
-  builder.FinishSizePrefixed(flatbuffers::Offset<void>(builder.EndTable(start)), "FRME");
-  return {builder.GetBufferPointer(), builder.GetBufferPointer() + builder.GetSize()};
+  const flatbuffers::Offset<void> frame(builder.EndTable(start));
+  if (writer == Writer::Dv) {
+    builder.FinishSizePrefixed(frame, "FRME");
+  } else {
+    builder.Finish(frame);
+  }
+  return stored(builder, writer);
 }
 
 /// An AEDAT 4.0 file (uncompressed) of an event stream (0) and, unless `frames_stream` is false, a
 /// frame stream (2), each payload a packet of the stream given.
 void write_aedat4(const std::filesystem::path& path, const std::vector<std::pair<int, std::vector<std::uint8_t>>>& packets,
-                  bool frames_stream = true) {
+                  bool frames_stream = true, Writer writer = Writer::Dv) {
   const std::string info = std::string(R"(<dv version="2.0"><node name="outInfo" path="/mainloop/Recorder/outInfo/">)") +
                            R"(<node name="0" path="/mainloop/Recorder/outInfo/0/"><attr key="typeIdentifier" type="string">EVTS</attr></node>)" +
                            (frames_stream ? R"(<node name="2" path="/mainloop/Recorder/outInfo/2/"><attr key="typeIdentifier" type="string">FRME</attr></node>)" : "") +
                            "</node></dv>";
   flatbuffers::FlatBufferBuilder header;
-  aedat4::FinishSizePrefixedIOHeaderBuffer(header, aedat4::CreateIOHeaderDirect(header, aedat4::CompressionType::NONE, -1, info.c_str()));
-  std::vector<std::uint8_t> data(header.GetBufferPointer(), header.GetBufferPointer() + header.GetSize());
+  const auto table = aedat4::CreateIOHeaderDirect(header, aedat4::CompressionType::NONE, -1, info.c_str());
+  if (writer == Writer::Dv) {
+    aedat4::FinishSizePrefixedIOHeaderBuffer(header, table);
+  } else {
+    header.Finish(table);
+  }
+  std::vector<std::uint8_t> data = stored(header, writer);
   for (const auto& [stream, payload] : packets) {
     put32(data, static_cast<std::uint32_t>(stream));
     put32(data, static_cast<std::uint32_t>(payload.size()));
@@ -590,6 +612,29 @@ TEST_F(FramesTest, Aedat4FrameStreamsReadGreyAndColourAtTheMiddleOfTheirExposure
     EXPECT_NE(frame->name.find("dv.aedat4: frame packet at byte "), std::string::npos) << frame->name;
   }
   EXPECT_FALSE(reader->next());
+}
+
+// The aedat library's frames (each FlatBuffer finished plain, its size put in front) read as DV's.
+TEST_F(FramesTest, Aedat4FramesWithTheirSizePutInFrontReadAsDvs) {
+  std::filesystem::create_directories(folder_);
+  const auto frames = [](Writer writer) {
+    return std::vector<std::pair<int, std::vector<std::uint8_t>>>{
+        {2, dv_frame(1'000'000, 1'000'000, 1'004'000, 0, square(4), 0, writer)},
+        {2, dv_frame(1'040'000, 1'040'000, 1'041'000, 16, coloured_square(16), 0, writer)}};
+  };
+  write_aedat4(folder_ / "dv.aedat4", frames(Writer::Dv));
+  write_aedat4(folder_ / "aedat-library.aedat4", frames(Writer::AedatLibrary), true, Writer::AedatLibrary);
+  const auto from_dv = open_frames(folder_ / "dv.aedat4", "", kSensor);
+  const auto from_library = open_frames(folder_ / "aedat-library.aedat4", "", kSensor);
+  for (int k = 0; k < 2; ++k) {
+    const auto expected = from_dv->next();
+    const auto frame = from_library->next();
+    ASSERT_TRUE(expected);
+    ASSERT_TRUE(frame) << k;
+    EXPECT_EQ(frame->t_us, expected->t_us);
+    EXPECT_EQ(cv::norm(frame->image, expected->image, cv::NORM_INF), 0.0) << k;
+  }
+  EXPECT_FALSE(from_library->next());
 }
 
 TEST_F(FramesTest, Aedat4BadFramesNameTheFrame) {

@@ -12,6 +12,7 @@
 #include "decompress.hpp"
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_format.hpp"
+#include "evldt/events/size_prefixed_flatbuffer.hpp"
 
 namespace evldt {
 namespace {
@@ -99,11 +100,9 @@ class Aedat4Container {
     file_.read_exactly(header.data() + 4, header_size, "the header");
     // The identifier "IOHE" is DV's; other writers leave it out, so it is not required. The verifier
     // checks the rest (every offset, the table's fields in whatever order its vtable lists them).
-    flatbuffers::Verifier verifier(header.data(), header.size());
-    if (!verifier.VerifySizePrefixedBuffer<aedat4::IOHeader>(nullptr)) {
-      throw FormatError(path_, header_at_, "the header is not a valid IOHeader FlatBuffer");
-    }
-    const aedat4::IOHeader* io = aedat4::GetSizePrefixedIOHeader(header.data());
+    std::vector<std::uint64_t> aligned;
+    const aedat4::IOHeader* io = verified_size_prefixed_root<aedat4::IOHeader>(header, aligned);
+    if (io == nullptr) throw FormatError(path_, header_at_, "the header is not a valid IOHeader FlatBuffer");
     compression_ = io->compression();
     if (compression_ < aedat4::CompressionType::NONE || compression_ > aedat4::CompressionType::ZSTD_HIGH) {
       throw FormatError(path_, header_at_, "unknown compression " + std::to_string(static_cast<int>(compression_)));
@@ -237,11 +236,9 @@ class Aedat4Images final : public ImageSource {
     std::uint64_t at = 0;
     if (!container_.next_packet(stream_id_, payload_, at)) return false;
     location = container_.path() + ": frame packet at byte " + std::to_string(at);
-    flatbuffers::Verifier verifier(payload_.data(), payload_.size());
-    if (!verifier.VerifySizePrefixedBuffer<dv::Frame>(nullptr)) {  // the identifier FRME is DV's alone
-      throw std::runtime_error(location + ": not a valid Frame FlatBuffer");
-    }
-    const dv::Frame* frame = dv::GetSizePrefixedFrame(payload_.data());
+    // The identifier FRME is DV's alone: not required.
+    const dv::Frame* frame = verified_size_prefixed_root<dv::Frame>(payload_, aligned_);
+    if (frame == nullptr) throw std::runtime_error(location + ": not a valid Frame FlatBuffer");
     int channels = 1;
     switch (frame->format()) {
       case dv::FrameFormat::OPENCV_8U_C1: image.encoding = "mono8"; break;
@@ -276,6 +273,7 @@ class Aedat4Images final : public ImageSource {
   Aedat4Container container_;
   int stream_id_ = -1;
   std::vector<std::uint8_t> payload_;
+  std::vector<std::uint64_t> aligned_;  ///< where a frame not aligned from its own origin is read
 };
 
 }  // namespace

@@ -1,15 +1,15 @@
 // "dv_events": iniVation's polarity event packet, the payload of an AEDAT 4.0 "EVTS" stream after
 // decompression: a size-prefixed FlatBuffer (schemas/dv_events.fbs) of 16-byte events, t (us), x, y,
-// polarity. A container hands each packet whole, in one decode() call. The buffer is verified before
-// any field is read.
+// polarity, in DV's layout or the aedat library's (size_prefixed_flatbuffer.hpp). A container hands
+// each packet whole, in one decode() call. The buffer is verified before any field is read.
 
 #include <flatbuffers/flatbuffers.h>
 
-#include <cstring>
 #include <vector>
 
 #include "dv_events_generated.h"
 #include "evldt/events/event_decoder.hpp"
+#include "evldt/events/size_prefixed_flatbuffer.hpp"
 
 namespace evldt::detail {
 namespace {
@@ -20,18 +20,9 @@ class DvEventsDecoder final : public EventDecoder {
 
   void decode(std::span<const std::uint8_t> packet, EventBatch& batch) override {
     EventBatch::Appender out(batch);
-    if (reinterpret_cast<std::uintptr_t>(packet.data()) % alignof(std::uint64_t) != 0) {
-      // FlatBuffers reads its fields in place: a packet handed at an odd address is copied first.
-      aligned_.resize((packet.size() + sizeof(std::uint64_t) - 1) / sizeof(std::uint64_t));
-      std::memcpy(aligned_.data(), packet.data(), packet.size());
-      packet = {reinterpret_cast<const std::uint8_t*>(aligned_.data()), packet.size()};
-    }
     // The identifier EVTS is DV's; other writers leave it out, so it is not required.
-    flatbuffers::Verifier verifier(packet.data(), packet.size());
-    if (!verifier.VerifySizePrefixedBuffer<dv::EventPacket>(nullptr)) {
-      throw FormatError(source_, 0, "not a valid size-prefixed FlatBuffer event packet");
-    }
-    const dv::EventPacket* events = dv::GetSizePrefixedEventPacket(packet.data());
+    const dv::EventPacket* events = verified_size_prefixed_root<dv::EventPacket>(packet, aligned_);
+    if (events == nullptr) throw FormatError(source_, 0, "not a valid size-prefixed FlatBuffer event packet");
     if (events->elements() == nullptr) return;
     for (const dv::Event* event : *events->elements()) {
       if (event->x() < 0 || event->y() < 0) {
