@@ -347,13 +347,37 @@ TEST(StreamEvaluator, CumulativePerSecondSumsTheStepsUpToEachSecond) {
   predict(evaluator, 0, 1, {moving_line(0)});
   predict(evaluator, 500'000, 1, {moving_line(0)});
   evaluator.finish();
-  const std::vector<Prf> seconds = evaluator.cumulative_per_second();
+  const auto seconds = evaluator.per_second();
   ASSERT_EQ(seconds.size(), 3u);  // 0 and 0.5 s in the first, 1.5 and 2 s in the second, 2.5 s in the third
-  EXPECT_DOUBLE_EQ(seconds[0].recall, 1.0);
-  EXPECT_DOUBLE_EQ(seconds[1].recall, 2.0 / 4.0);
-  EXPECT_DOUBLE_EQ(seconds[2].recall, 2.0 / 5.0);
-  EXPECT_DOUBLE_EQ(seconds[2].precision, 1.0);
-  EXPECT_DOUBLE_EQ(seconds[2].recall, evaluator.accuracy().summed_prf(0).recall);
+  EXPECT_EQ(seconds[0].steps, 2u);
+  EXPECT_EQ(seconds[1].steps, 2u);
+  EXPECT_EQ(seconds[2].steps, 1u);
+  EXPECT_DOUBLE_EQ(seconds[0].cumulative.recall, 1.0);
+  EXPECT_DOUBLE_EQ(seconds[1].cumulative.recall, 2.0 / 4.0);
+  EXPECT_DOUBLE_EQ(seconds[2].cumulative.recall, 2.0 / 5.0);
+  EXPECT_DOUBLE_EQ(seconds[2].cumulative.precision, 1.0);
+  EXPECT_DOUBLE_EQ(seconds[2].cumulative.recall, evaluator.accuracy().summed_prf(0).recall);
+  EXPECT_EQ(evaluator.seconds_origin(), Timestamp{0});
+}
+
+// A second that holds no step says so (the table prints '-' there), and still carries the sums so far.
+TEST(StreamEvaluator, PerSecondCountsTheStepsOfEachSecondAndNoneWhereThereAreNone) {
+  GroundTruthSteps truth;
+  truth.times = {200'000, 2'500'000};
+  truth.segments_at = [](std::size_t, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments.assign(1, moving_line(0));
+    ids.assign(1, 3);
+  };
+  StreamEvaluator evaluator(kSensor, {0.01}, truth, 100'000);
+  predict(evaluator, 200'000, 1, {moving_line(0)});
+  evaluator.finish();
+  const auto seconds = evaluator.per_second();
+  ASSERT_EQ(seconds.size(), 3u);
+  EXPECT_EQ(seconds[0].steps, 1u);
+  EXPECT_EQ(seconds[1].steps, 0u);
+  EXPECT_EQ(seconds[2].steps, 1u);
+  EXPECT_DOUBLE_EQ(seconds[1].cumulative.recall, 1.0);
+  EXPECT_DOUBLE_EQ(seconds[2].cumulative.recall, 0.5);
 }
 
 // The steps of an lcm-log's recorded span (evldt-eval --segments LOG): each kept step keeps its own
@@ -388,7 +412,7 @@ TEST(StreamEvaluator, CumulativePerSecondIsTheSameOnAClockShiftedToTheEpochOrThe
     predict(evaluator, origin + 500'000, 1, {moving_line(0)});
     evaluator.finish();
     std::vector<double> recalls;
-    for (const Prf& p : evaluator.cumulative_per_second()) recalls.push_back(p.recall);
+    for (const auto& second : evaluator.per_second()) recalls.push_back(second.cumulative.recall);
     return recalls;
   };
   const std::vector<double> from_zero = seconds_from(0);

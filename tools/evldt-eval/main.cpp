@@ -56,7 +56,8 @@ struct Report {
   LifetimeSummary lifetime;
   TrackingSummary tracking;
   std::optional<SupportSummary> support;  ///< whole lines: their support by the segments of their step
-  std::vector<Prf> per_second;            ///< cumulative, at the first tolerance
+  std::vector<StreamEvaluator::Second> per_second;  ///< cumulative, at the first tolerance
+  std::optional<Timestamp> seconds_origin;          ///< t0 of per_second
   std::vector<EdgeStep> edge_steps;       ///< with --edge-recall: each true edge at each step
   std::uint64_t events = 0;
   double scene_seconds = 0, wall_seconds = 0;
@@ -73,7 +74,8 @@ Report make_report(const StreamEvaluator& evaluator) {
   r.hold_us = evaluator.hold_us();
   r.lifetime = evaluator.lifetimes().summary();
   r.tracking = evaluator.tracking().summary();
-  r.per_second = evaluator.cumulative_per_second();
+  r.per_second = evaluator.per_second();
+  r.seconds_origin = evaluator.seconds_origin();
   if (evaluator.edge_recall()) r.edge_steps = evaluator.edge_recall()->steps();
   return r;
 }
@@ -252,16 +254,24 @@ SupportSummary file_support(const std::vector<SegmentRow>& segment_rows, const s
   return support.summary();
 }
 
-// The paper's view: precision / recall summed over the steps up to each second, the first 10.
+// The paper's view: precision / recall summed over the steps up to the end of each second, the first 10.
+// A second is labelled by the span of the clock it holds; one without a ground-truth step prints '-'.
 void print_per_second(const std::vector<Report>& reports, const Options& options) {
   constexpr std::size_t kSeconds = 10;
-  std::printf("cumulative P / R at %.3g%% of the diagonal, up to each second:\n", options.tolerances.front() * 100);
+  std::printf("cumulative P / R at %.3g%% of the diagonal, over the steps up to the end of each second of the clock "
+              "(counted from t0, the whole second before the first step; -: no step in that second):\n",
+              options.tolerances.front() * 100);
+  const auto number = [](double value) { return std::isfinite(value) ? fmt::format("{:.3f}", value) : std::string("n/a"); };
   for (const Report& r : reports) {
-    std::printf("%-26s", r.label.c_str());
+    std::string row = fmt::format("{:<26}", r.label);
+    if (r.seconds_origin) row += fmt::format(" t0 {:.0f} s:", static_cast<double>(*r.seconds_origin) * 1e-6);
     for (std::size_t k = 0; k < std::min(kSeconds, r.per_second.size()); ++k) {
-      std::printf("  %zu s %.3f / %.3f", k + 1, r.per_second[k].precision, r.per_second[k].recall);
+      const StreamEvaluator::Second& second = r.per_second[k];
+      row += fmt::format("  {}-{} s ", k, k + 1);
+      row += second.steps == 0 ? std::string("-")
+                               : number(second.cumulative.precision) + " / " + number(second.cumulative.recall);
     }
-    std::printf("\n");
+    std::printf("%s\n", row.c_str());
   }
 }
 
@@ -292,8 +302,10 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
     }
     json.end_array();
     json.key("cumulative_per_second").begin_array();
-    for (const Prf& p : r.per_second) {
-      json.begin_object().key("precision").value(p.precision).key("recall").value(p.recall).key("f").value(p.f).end_object();
+    for (const StreamEvaluator::Second& second : r.per_second) {
+      const Prf& p = second.cumulative;
+      json.begin_object().key("steps").value(second.steps);
+      json.key("precision").value(p.precision).key("recall").value(p.recall).key("f").value(p.f).end_object();
     }
     json.end_array();
     json.key("mean_segments_per_step").value(r.mean_predicted).key("mean_gt_segments_per_step").value(r.mean_ground_truth);

@@ -172,18 +172,22 @@ void StreamEvaluator::add_to_second(Timestamp t, const MatchCounts& counts) {
     throw std::length_error("ground-truth steps span more than " + std::to_string(kMaxSeconds) +
                             " seconds: the per-second table would not fit (a step at " + std::to_string(t) + " us)");
   }
-  if (per_second_.size() <= second) per_second_.resize(static_cast<std::size_t>(second) + 1);
+  if (per_second_.size() <= second) {
+    per_second_.resize(static_cast<std::size_t>(second) + 1);
+    steps_per_second_.resize(static_cast<std::size_t>(second) + 1);
+  }
   per_second_[static_cast<std::size_t>(second)] += counts;
+  ++steps_per_second_[static_cast<std::size_t>(second)];
 }
 
-std::vector<Prf> StreamEvaluator::cumulative_per_second() const {
-  std::vector<Prf> cumulative;
+std::vector<StreamEvaluator::Second> StreamEvaluator::per_second() const {
+  std::vector<Second> seconds;
   MatchCounts sum;
-  for (const MatchCounts& second : per_second_) {
-    sum += second;
-    cumulative.push_back(prf(sum));
+  for (std::size_t k = 0; k < per_second_.size(); ++k) {
+    sum += per_second_[k];
+    seconds.push_back({steps_per_second_[k], prf(sum)});
   }
-  return cumulative;
+  return seconds;
 }
 
 void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted,

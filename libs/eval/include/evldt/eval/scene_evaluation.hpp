@@ -77,11 +77,18 @@ class StreamEvaluator {
   /// Tracking metrics, at the first tolerance.
   [[nodiscard]] const TrackingEvaluator& tracking() const { return tracking_; }
   [[nodiscard]] const StepCoverage& coverage() const { return coverage_; }
-  /// The paper's view, at the first tolerance: element k - 1 is the P/R/F of the counts summed over
-  /// the ground-truth steps up to k seconds, for each second up to the last step's. Seconds count
-  /// from the whole second of the clock that holds the first step, t0: a step at t belongs to second
-  /// ceil((t - t0) / 1 s), t0 itself to the first. Throws std::length_error past kMaxSeconds.
-  [[nodiscard]] std::vector<Prf> cumulative_per_second() const;
+  /// One second of the paper's view: its ground-truth steps, and the P/R/F of the counts summed over
+  /// the steps up to its end (at the first tolerance).
+  struct Second {
+    std::uint64_t steps = 0;
+    Prf cumulative;
+  };
+  /// The paper's view: element k - 1 holds the steps in (t0 + k - 1 s, t0 + k s], for each second up to
+  /// the last step's. Seconds count from the whole second of the clock that holds the first step, t0
+  /// (seconds_origin()), which the first second also holds. Throws std::length_error past kMaxSeconds.
+  [[nodiscard]] std::vector<Second> per_second() const;
+  /// t0 of per_second(); none before the first step.
+  [[nodiscard]] std::optional<Timestamp> seconds_origin() const { return seconds_origin_; }
   static constexpr std::uint64_t kMaxSeconds = 1'000'000;  ///< of the per-second table: 11.6 days
   [[nodiscard]] Timestamp hold_us() const { return hold_us_; }
   /// Also keep the recall of each true edge at each step, at the first tolerance (before any step).
@@ -106,6 +113,7 @@ class StreamEvaluator {
   LifetimeTracker lifetimes_;
   TrackingEvaluator tracking_;
   std::vector<MatchCounts> per_second_;  // first tolerance, by second of the step time
+  std::vector<std::uint64_t> steps_per_second_;
   std::optional<Timestamp> seconds_origin_;  // t0 of cumulative_per_second(), set by the first step
   GroundTruthSteps ground_truth_;
   Timestamp hold_us_;
