@@ -112,6 +112,10 @@ if ((log_complete)); then
   kill "$replay_probe_pid"
   cat "$work/replay_lines.out"
   check "replayed lines received every batch" grep -q "batches   $batches received, 0 lost" "$work/replay_lines.out"
+  # The log keeps the recording's publish stamps, seconds behind the replay: latency from receipt.
+  check "the replay's latency is measured from receipt" grep -q "latency   batch receipt -> segment list" "$work/replay_lines.out"
+  check "... and says why" grep -q "measured from receipt for [0-9]* batches: their publish stamps are [0-9.]* ms behind" "$work/replay_lines.out"
+  check "the live run's latency is measured from publish" grep -q "latency   batch publish -> segment list" "$work/lines.out"
   "$eval_tool" --segments "$work/replay.lcm" "${scene[@]}" --json "$work/replay.json" >/dev/null 2>&1
   replay_f=$(f_at_1_percent "$work/replay.json")
   echo "F@1%: replayed $replay_f"

@@ -602,9 +602,9 @@ TEST(SequenceTracker, ForgedHugeSequenceDoesNotOverflow) {
 
 TEST(LatencyTracker, MeasuresFromPublishToTheListThatIncludesTheBatch) {
   LatencyTracker tracker(4, 100);
-  tracker.batch_stored(0, 1000, 100);
-  tracker.batch_stored(1, 2000, 200);
-  tracker.batch_stored(2, 3000, 300);
+  tracker.batch_stored(0, 1000, 1100, 100);  // received 0.1 ms after its publish
+  tracker.batch_stored(1, 2000, 2100, 200);
+  tracker.batch_stored(2, 3000, 3100, 300);
   auto included = tracker.list_published(150, 5000);  // only batch 0: 4 ms
   EXPECT_EQ(included.seq, 0);
   EXPECT_EQ(included.utime, 1000);
@@ -625,7 +625,7 @@ TEST(LatencyTracker, MeasuresFromPublishToTheListThatIncludesTheBatch) {
 
 TEST(LatencyTracker, ForgetsTheOldestBeyondCapacity) {
   LatencyTracker tracker(2, 100);
-  for (std::int64_t seq = 0; seq < 5; ++seq) tracker.batch_stored(seq, seq * 1000, seq * 10);
+  for (std::int64_t seq = 0; seq < 5; ++seq) tracker.batch_stored(seq, seq * 1000, seq * 1000 + 100, seq * 10);
   tracker.list_published(1000, 10000);
   EXPECT_EQ(tracker.take_summary().samples, 2u);  // batches 3 and 4 only
 }
@@ -635,7 +635,7 @@ TEST(LatencyTracker, SettledFiguresLeaveOutTheStreamsFirstSecond) {
   // A slow start: the first second's batches wait 30 ms for their list, the later ones 2 ms.
   for (std::int64_t k = 0; k < 20; ++k) {
     const std::int64_t publish = k * 100'000;  // 0.1 s apart
-    tracker.batch_stored(k, publish, k * 100);
+    tracker.batch_stored(k, publish, publish + 100, k * 100);
     tracker.list_published(k * 100, publish + (publish < LatencyTracker::kSettleUs ? 30'000 : 2'000));
   }
   const LatencySummary run = tracker.run_summary();
@@ -645,6 +645,34 @@ TEST(LatencyTracker, SettledFiguresLeaveOutTheStreamsFirstSecond) {
   EXPECT_EQ(settled.samples, 10u);  // published 1.0 s .. 1.9 s after the first
   EXPECT_NEAR(settled.median_ms, 2.1, 1e-9);
   EXPECT_NEAR(settled.p99_ms, 2.1, 1e-9);
+}
+
+// A replayed log keeps the recording's publish stamps, here a second behind this host's clock; a
+// camera host's clock may be set apart either way. Measured from the stamps, every batch would read
+// as a second late: the latency is measured from receipt instead, and the offset is known. Clocks
+// within kClocksApartUs measure from the publish, their transit included.
+TEST(LatencyTracker, PublishStampsFarFromOurClockAreMeasuredFromReceipt) {
+  for (const std::int64_t behind : {std::int64_t{1'000'000}, std::int64_t{-600'000}, std::int64_t{30'000}}) {
+    SCOPED_TRACE(behind);
+    LatencyTracker tracker(64, 100);
+    for (std::int64_t k = 0; k < 50; ++k) {
+      const std::int64_t publish = 5'000'000 + k * 10'000;
+      const std::int64_t received = publish + behind + 200 + (k % 3) * 100;  // 0.2-0.4 ms transit
+      tracker.batch_stored(k, publish, received, k * 10'000);
+      tracker.list_published(k * 10'000, received + 2'000);  // each in a list 2 ms after it came
+    }
+    const bool apart = behind > LatencyTracker::kClocksApartUs;
+    ASSERT_TRUE(tracker.publish_clock_offset_us().has_value());
+    EXPECT_EQ(*tracker.publish_clock_offset_us(), behind + 200);
+    EXPECT_EQ(tracker.measured_from_receipt(), apart || behind < 0 ? 50u : 0u);
+    const LatencySummary run = tracker.run_summary();
+    EXPECT_EQ(run.samples, 50u);
+    if (apart || behind < 0) {
+      EXPECT_NEAR(run.median_ms, 2.05, 0.06);  // 2 ms, in bins of 0.1 ms
+    } else {
+      EXPECT_NEAR(run.median_ms, 32.35, 0.06);  // 32.3 ms: the 30 ms apart and the transit count
+    }
+  }
 }
 
 // ---- receiving end -----------------------------------------------------------------------------
@@ -1004,46 +1032,50 @@ std::vector<std::uint8_t> bytes_of(std::size_t size, std::uint8_t fill) { return
 TEST(PayloadQueue, HandsOverPayloadsInOrderAndGrowsASlotForALargeOne) {
   evldt::PayloadQueue queue(3, 16);
   const std::atomic<bool> never{false};
-  ASSERT_TRUE(queue.push(bytes_of(5, 1), never));
-  ASSERT_TRUE(queue.push(bytes_of(40, 2), never));  // larger than a slot: that slot grows
-  ASSERT_TRUE(queue.push({}, never));
+  ASSERT_TRUE(queue.push(bytes_of(5, 1), 100, never));
+  ASSERT_TRUE(queue.push(bytes_of(40, 2), 200, never));  // larger than a slot: that slot grows
+  ASSERT_TRUE(queue.push({}, 300, never));
+  std::int64_t received = 100;
   for (const auto& [size, fill] : std::vector<std::pair<std::size_t, std::uint8_t>>{{5, 1}, {40, 2}, {0, 0}}) {
     const auto payload = queue.front(std::chrono::milliseconds(0));
     ASSERT_TRUE(payload.has_value());
-    ASSERT_EQ(payload->size(), size);
-    for (const std::uint8_t byte : *payload) EXPECT_EQ(byte, fill);
+    ASSERT_EQ(payload->bytes.size(), size);
+    EXPECT_EQ(payload->received_utime, received);
+    for (const std::uint8_t byte : payload->bytes) EXPECT_EQ(byte, fill);
     queue.pop();
+    received += 100;
   }
   EXPECT_FALSE(queue.front(std::chrono::milliseconds(1)).has_value());
   EXPECT_EQ(queue.high_water(), 3u);
   // The slots go round: a fourth and fifth payload reuse the first two.
-  ASSERT_TRUE(queue.push(bytes_of(7, 4), never));
-  ASSERT_TRUE(queue.push(bytes_of(30, 5), never));
-  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 7u);
+  ASSERT_TRUE(queue.push(bytes_of(7, 4), 400, never));
+  ASSERT_TRUE(queue.push(bytes_of(30, 5), 500, never));
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->bytes.size(), 7u);
   queue.pop();
-  EXPECT_EQ((*queue.front(std::chrono::milliseconds(0)))[29], 5);
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->bytes[29], 5);
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->received_utime, 500);
 }
 
 TEST(PayloadQueue, AFullQueueHoldsTheProducerUntilASlotFreesOrItStops) {
   evldt::PayloadQueue queue(1, 8);
   std::atomic<bool> stop{false};
-  ASSERT_TRUE(queue.push(bytes_of(1, 1), stop));
+  ASSERT_TRUE(queue.push(bytes_of(1, 1), 1, stop));
   std::atomic<bool> second_queued{false};
-  std::thread producer([&] { second_queued = queue.push(bytes_of(2, 2), stop); });
+  std::thread producer([&] { second_queued = queue.push(bytes_of(2, 2), 2, stop); });
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_FALSE(second_queued.load());  // waits: nothing was dropped or overwritten
-  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 1u);
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->bytes.size(), 1u);
   queue.pop();
   producer.join();
   EXPECT_TRUE(second_queued.load());
-  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 2u);
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->bytes.size(), 2u);
 
   // Full again, and stopped meanwhile: the producer gives up.
-  std::thread stopped_producer([&] { second_queued = queue.push(bytes_of(3, 3), stop); });
+  std::thread stopped_producer([&] { second_queued = queue.push(bytes_of(3, 3), 3, stop); });
   stop = true;
   stopped_producer.join();
   EXPECT_FALSE(second_queued.load());
-  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->size(), 2u);
+  EXPECT_EQ(queue.front(std::chrono::milliseconds(0))->bytes.size(), 2u);
   EXPECT_THROW(evldt::PayloadQueue(0, 8), std::invalid_argument);
 }
 

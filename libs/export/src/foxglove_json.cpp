@@ -69,9 +69,10 @@ const std::string& stats_schema() {
     R"("service": {"type": "string"}, "source": {"type": "string"}, "events_in": {"type": "integer"}, "event_rate": {"type": "number"}, )"
     R"("batches_received": {"type": "integer"}, "batches_lost": {"type": "integer"}, "batches_shed": {"type": "integer"}, "events_shed": {"type": "integer"}, )"
     R"("detect_hz": {"type": "number"}, "track_hz": {"type": "number"}, "live_lines": {"type": "integer"}, )"
-    R"("latency_median_ms": {"type": "number"}, "latency_p99_ms": {"type": "number"}, "filters": {"type": "string"}, "masked_pixels": {"type": "integer"}}, )"
+    R"("latency_median_ms": {"type": "number"}, "latency_p99_ms": {"type": "number"}, "latency_from_receipt": {"type": "boolean"}, )"
+    R"("filters": {"type": "string"}, "masked_pixels": {"type": "integer"}}, )"
     R"("required": ["timestamp", "service", "source", "events_in", "event_rate", "batches_received", "batches_lost", "batches_shed", "events_shed", )"
-    R"("detect_hz", "track_hz", "live_lines", "latency_median_ms", "latency_p99_ms", "filters", "masked_pixels"]})";
+    R"("detect_hz", "track_hz", "live_lines", "latency_median_ms", "latency_p99_ms", "latency_from_receipt", "filters", "masked_pixels"]})";
   return schema;
 }
 
@@ -152,10 +153,11 @@ std::string image_annotations_json(std::uint64_t time_ns, std::span<const Tracke
 std::string stats_json(std::uint64_t time_ns, const stats_t& stats) {
   return fmt::format(R"({{"timestamp": {}, "service": {}, "source": {}, "events_in": {}, "event_rate": {:.1f}, "batches_received": {}, )"
                      R"("batches_lost": {}, "batches_shed": {}, "events_shed": {}, "detect_hz": {:.1f}, "track_hz": {:.1f}, "live_lines": {}, )"
-                     R"("latency_median_ms": {:.2f}, "latency_p99_ms": {:.2f}, "filters": {}, "masked_pixels": {}}})",
+                     R"("latency_median_ms": {:.2f}, "latency_p99_ms": {:.2f}, "latency_from_receipt": {}, "filters": {}, "masked_pixels": {}}})",
                      time_json(time_ns), json_quoted(stats.service), json_quoted(stats.source), stats.events_in, stats.event_rate, stats.batches_received,
                      stats.batches_lost, stats.batches_shed, stats.events_shed, stats.detect_hz, stats.track_hz, stats.live_lines,
-                     stats.latency_median_ms, stats.latency_p99_ms, json_quoted(stats.filters), stats.num_masked_pixels);
+                     stats.latency_median_ms, stats.latency_p99_ms, stats.latency_from_receipt ? "true" : "false", json_quoted(stats.filters),
+                     stats.num_masked_pixels);
 }
 
 std::string camera_calibration_json(std::uint64_t time_ns, const camera_info_t& info) {

@@ -92,7 +92,9 @@ LatencySummary LinesIngest::take_latency_summary() {
   return latency_.take_summary();
 }
 
-void LinesIngest::queue(std::span<const std::uint8_t> payload, const std::atomic<bool>& stop) { queue_.push(payload, stop); }
+void LinesIngest::queue(std::span<const std::uint8_t> payload, std::int64_t received_utime, const std::atomic<bool>& stop) {
+  queue_.push(payload, received_utime, stop);
+}
 
 void LinesIngest::store_loop(const std::atomic<bool>& stop) {
   name_this_thread("evldt-store");
@@ -104,8 +106,8 @@ void LinesIngest::store_loop(const std::atomic<bool>& stop) {
   }
 }
 
-void LinesIngest::store(std::span<const std::uint8_t> payload) {
-  const bool accepted = receiver_.receive(payload, batch_, budget_, wall_clock_us());
+void LinesIngest::store(const PayloadQueue::Queued& payload) {
+  const bool accepted = receiver_.receive(payload.bytes, batch_, budget_, wall_clock_us());
   if (accepted && (!engine_ || receiver_.restarted())) {
     start_engine();
     // The batches that queued while the lattice and the rounds were built (tens of ms at
@@ -132,7 +134,7 @@ void LinesIngest::store(std::span<const std::uint8_t> payload) {
   std::lock_guard lock(mutex_);
   receiver_counts_ = receiver_.counts();
   if (accepted && !batch_.empty()) {
-    latency_.batch_stored(receiver_.message().seq, receiver_.message().utime, batch_.t.back());
+    latency_.batch_stored(receiver_.message().seq, receiver_.message().utime, payload.received_utime, batch_.t.back());
   }
 }
 
@@ -173,6 +175,8 @@ void LinesIngest::add_to(LinesNodeTotals& totals) const {
     totals.engine_restarts = engine_restarts_;
     totals.latency = latency_.run_summary();
     totals.settled_latency = latency_.settled_summary();
+    totals.latency_from_receipt = latency_.measured_from_receipt();
+    totals.publish_clock_offset_us = latency_.publish_clock_offset_us();
   }
   if (engine) add_counts(all, engine->counters());
   totals.events_stored = all.events;

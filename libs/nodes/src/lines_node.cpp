@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <stdexcept>
 #include <thread>
@@ -32,10 +33,19 @@ void LinesNodeTotals::print(std::FILE* out, const LinesNodeOptions& options) con
              detect_rounds_without_bend_test, track_rounds);
   fmt::print(out, "  output    {} lines created, {} segment lists published, {} whole-line lists ({} at {} Hz while shedding)\n",
              lines_created, lists_published, whole_lists_published, whole_lists_while_shedding, options.whole_lines_loaded_hz);
-  fmt::print(out, "  latency   batch publish -> segment list: median {:.1f} ms, p99 {:.1f} ms ({} batches); settled, from 1 s after\n",
-             latency.median_ms, latency.p99_ms, latency.samples);
+  // A replayed log keeps the recording's publish stamps: measured from them, nothing late would read as lag.
+  const bool from_receipt = latency_from_receipt > 0;
+  fmt::print(out, "  latency   batch {} -> segment list: median {:.1f} ms, p99 {:.1f} ms ({} batches); settled, from 1 s after\n",
+             from_receipt ? "receipt" : "publish", latency.median_ms, latency.p99_ms, latency.samples);
   fmt::print(out, "            the first batch: median {:.1f} ms, p99 {:.1f} ms ({} batches)\n", settled_latency.median_ms,
              settled_latency.p99_ms, settled_latency.samples);
+  if (from_receipt) {
+    fmt::print(out,
+               "            measured from receipt for {} batches: their publish stamps are {:.1f} ms {} this host's clock\n"
+               "            (a log replayed by lcm-logplayer keeps the recording's, or the camera host's clock is set apart)\n",
+               latency_from_receipt, std::abs(static_cast<double>(publish_clock_offset_us.value_or(0))) * 1e-3,
+               publish_clock_offset_us.value_or(0) >= 0 ? "behind" : "ahead of");
+  }
 }
 
 LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch_us)
@@ -88,7 +98,7 @@ LinesNode::~LinesNode() {
 
 void LinesNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
   // Only queued here (waiting while the queue is full), so that LCM's own queue stays short.
-  ingest_.queue(std::span(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size), *stop_);
+  ingest_.queue(std::span(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size), buffer->recv_utime, *stop_);
 }
 
 void LinesNode::run(const std::atomic<bool>& stop) {

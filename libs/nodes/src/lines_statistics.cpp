@@ -42,6 +42,8 @@ void LinesStatistics::publish(const LinesNodeTotals& now, const LatencySummary& 
   msg.latency_samples = static_cast<std::int32_t>(latency.samples);
   msg.latency_median_ms = static_cast<float>(latency.median_ms);
   msg.latency_p99_ms = static_cast<float>(latency.p99_ms);
+  msg.latency_from_receipt = now.latency_from_receipt > last_.latency_from_receipt;
+  msg.publish_clock_offset_ms = static_cast<double>(now.publish_clock_offset_us.value_or(0)) * 1e-3;
   msg.latency_budget_ms = static_cast<float>(options_.max_latency_ms);
   msg.batches_shed = static_cast<std::int64_t>(now.receiver.batches_shed);
   msg.events_shed = static_cast<std::int64_t>(now.receiver.events_shed);

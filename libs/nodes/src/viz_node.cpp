@@ -112,7 +112,8 @@ void VizNode::update_status() {
                      fmt::format("{} lines", lines_.size()), fmt::format("{} whole", whole_lines_.size())});
   if (stats_) {
     status_.push_back({fmt::format("detect {:.0f} Hz", stats_->detect_hz), fmt::format("track {:.0f} Hz", stats_->track_hz),
-                       fmt::format("latency {:.1f}/{:.1f} ms", stats_->latency_median_ms, stats_->latency_p99_ms),
+                       fmt::format("latency {:.1f}/{:.1f} ms{}", stats_->latency_median_ms, stats_->latency_p99_ms,
+                                   stats_->latency_from_receipt ? " from receipt" : ""),
                        fmt::format("lost {}", stats_->batches_lost), fmt::format("shed {}", stats_->batches_shed),
                        fmt::format("hot pixels {}", stats_->num_masked_pixels)});
   } else {

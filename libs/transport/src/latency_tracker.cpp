@@ -20,21 +20,40 @@ void LatencyStatistics::add(double latency_ms) {
 LatencyTracker::LatencyTracker(std::size_t pending_capacity, std::size_t sample_capacity)
     : ring_(std::max<std::size_t>(pending_capacity, 1)), statistics_(sample_capacity) {}
 
-void LatencyTracker::batch_stored(std::int64_t seq, std::int64_t publish_utime, Timestamp newest_event_us) {
-  if (!first_utime_) first_utime_ = publish_utime;
+void LatencyTracker::batch_stored(std::int64_t seq, std::int64_t publish_utime, std::int64_t received_utime,
+                                  Timestamp newest_event_us) {
+  if (!first_utime_) {
+    first_utime_ = publish_utime;
+    window_start_ = received_utime;
+  }
+  if (received_utime - window_start_ >= kOffsetWindowUs) {
+    previous_least_ = current_least_;
+    current_least_.reset();
+    window_start_ = received_utime;
+  }
+  const std::int64_t delay = received_utime - publish_utime;
+  current_least_ = current_least_ ? std::min(*current_least_, delay) : delay;
+  const std::int64_t offset = *publish_clock_offset_us();
+  const bool from_receipt = offset > kClocksApartUs || offset < -kClocksApartUs;
   if (count_ == ring_.size()) {  // forget the oldest
     head_ = (head_ + 1) % ring_.size();
     --count_;
   }
-  ring_[(head_ + count_) % ring_.size()] = {seq, publish_utime, newest_event_us};
+  ring_[(head_ + count_) % ring_.size()] = {seq, publish_utime, received_utime, from_receipt, newest_event_us};
   ++count_;
+}
+
+std::optional<std::int64_t> LatencyTracker::publish_clock_offset_us() const {
+  if (!current_least_) return previous_least_;
+  return previous_least_ ? std::min(*current_least_, *previous_least_) : current_least_;
 }
 
 LatencyTracker::Included LatencyTracker::list_published(Timestamp lattice_us, std::int64_t now_utime) {
   // Batches arrive in event-time order, so the included ones are a prefix of the ring.
   while (count_ > 0 && ring_[head_].newest_event_us <= lattice_us) {
     const Pending& batch = ring_[head_];
-    const double latency_ms = static_cast<double>(now_utime - batch.utime) * 1e-3;
+    const double latency_ms = static_cast<double>(now_utime - (batch.from_receipt ? batch.received_utime : batch.utime)) * 1e-3;
+    from_receipt_ += batch.from_receipt ? 1 : 0;
     statistics_.add(latency_ms);
     if (batch.utime - *first_utime_ >= kSettleUs) settled_.add(latency_ms);
     newest_ = {batch.seq, batch.utime};

@@ -72,7 +72,7 @@ class WireWalker {
 // Encoded sizes of the fixed parts (see the .lcm files).
 constexpr std::size_t kSegmentWireBytes = 8 + 5 * 4 + 1 + 4 + 8 + 8 + 2 * 4;
 constexpr std::size_t kStatsMiddleBytes =
-    8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 4 + 2 * 8 + 2 * 8 + 8 + 4 + 2 * 4 + 8;  // period_s .. reconnects
+    8 + 6 * 8 + 2 * 8 + 4 + 8 + 4 + 2 * 4 + 1 + 8 + 4 + 2 * 8 + 2 * 8 + 8 + 4 + 2 * 4 + 8;  // period_s .. reconnects
 
 template <typename Message>
 WireError check_hash(WireWalker& walker) {

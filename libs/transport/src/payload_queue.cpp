@@ -11,7 +11,7 @@ PayloadQueue::PayloadQueue(std::size_t slots, std::size_t slot_bytes) : slots_(s
   for (Slot& slot : slots_) slot.bytes.resize(slot_bytes);  // zero-filled: every page touched now
 }
 
-bool PayloadQueue::push(std::span<const std::uint8_t> payload, const std::atomic<bool>& stop) {
+bool PayloadQueue::push(std::span<const std::uint8_t> payload, std::int64_t received_utime, const std::atomic<bool>& stop) {
   std::size_t index = 0;
   {
     std::unique_lock lock(mutex_);
@@ -26,6 +26,7 @@ bool PayloadQueue::push(std::span<const std::uint8_t> payload, const std::atomic
   if (slot.bytes.size() < payload.size()) slot.bytes.resize(payload.size());
   if (!payload.empty()) std::memcpy(slot.bytes.data(), payload.data(), payload.size());
   slot.size = payload.size();
+  slot.received_utime = received_utime;
   {
     std::lock_guard lock(mutex_);
     ++count_;
@@ -35,11 +36,11 @@ bool PayloadQueue::push(std::span<const std::uint8_t> payload, const std::atomic
   return true;
 }
 
-std::optional<std::span<const std::uint8_t>> PayloadQueue::front(std::chrono::milliseconds timeout) {
+std::optional<PayloadQueue::Queued> PayloadQueue::front(std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
   if (!not_empty_.wait_for(lock, timeout, [this] { return count_ > 0; })) return std::nullopt;
   const Slot& slot = slots_[head_];
-  return std::span<const std::uint8_t>(slot.bytes.data(), slot.size);
+  return Queued{std::span<const std::uint8_t>(slot.bytes.data(), slot.size), slot.received_utime};
 }
 
 void PayloadQueue::pop() {

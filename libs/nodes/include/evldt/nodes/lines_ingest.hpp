@@ -26,8 +26,9 @@ class LinesIngest {
   LinesIngest(const LinesIngest&) = delete;
   LinesIngest& operator=(const LinesIngest&) = delete;
 
-  /// LCM's handler: queues a batch's payload, waiting while the queue is full (until `stop`).
-  void queue(std::span<const std::uint8_t> payload, const std::atomic<bool>& stop);
+  /// LCM's handler: queues a batch's payload, received at `received_utime` (wall clock), waiting while
+  /// the queue is full (until `stop`).
+  void queue(std::span<const std::uint8_t> payload, std::int64_t received_utime, const std::atomic<bool>& stop);
   /// The storing thread: stores the queued batches until `stop` is set (checked every 100 ms).
   void store_loop(const std::atomic<bool>& stop);
   /// Stops the engine's rounds (idempotent).
@@ -48,7 +49,7 @@ class LinesIngest {
 
  private:
   /// Decodes one queued batch and stores it, thinned or shed if it queued longer than the budget.
-  void store(std::span<const std::uint8_t> payload);
+  void store(const PayloadQueue::Queued& payload);
   void start_engine();
   /// A started engine for `sensor` whose lines are numbered from `first_line_id`.
   [[nodiscard]] std::shared_ptr<RealtimeEngine> make_engine(SensorSize sensor, std::uint64_t first_line_id) const;

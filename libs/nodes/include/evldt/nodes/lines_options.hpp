@@ -57,6 +57,10 @@ struct LinesNodeTotals {
   std::uint64_t engine_restarts = 0;  ///< the camera restarted (new epoch): the lattice began afresh
   LatencySummary latency;             ///< batch publish -> first list including it, since the last camera (re)start
   LatencySummary settled_latency;     ///< the same, of the batches published 1 s or more after the first (LatencyTracker)
+  /// Batches whose latency was measured from their receipt: their publish stamps were far from this
+  /// host's clock (LatencyTracker::kClocksApartUs), by publish_clock_offset_us.
+  std::uint64_t latency_from_receipt = 0;
+  std::optional<std::int64_t> publish_clock_offset_us;
 
   /// The exit summary, with the options it was run with.
   void print(std::FILE* out, const LinesNodeOptions& options) const;

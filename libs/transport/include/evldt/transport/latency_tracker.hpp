@@ -1,6 +1,9 @@
 #pragma once
 // End-to-end latency of the lines service: from an event batch's publish (camera wall clock) to the
-// publish of the first segment list whose lattice state holds all its events. Fixed memory: a ring
+// publish of the first segment list whose lattice state holds all its events. Where the publish
+// stamps are far from this host's clock (a log replayed by lcm-logplayer keeps the recording's; a
+// camera host's clock may be set apart), the latency is measured from the batch's receipt instead:
+// from the stamps it would read as lag that is not there. Fixed memory: a ring
 // of batches waiting to be included and a bounded sample store per reporting period. The run's
 // figures are kept twice: from the stream's start, and once it has settled (batches published a
 // second or more after its first), since a stream's first tens of milliseconds meet cold caches and
@@ -44,8 +47,9 @@ class LatencyTracker {
   /// `sample_capacity`: latencies kept per period (later ones in the period are not kept).
   explicit LatencyTracker(std::size_t pending_capacity = 16384, std::size_t sample_capacity = 65536);
 
-  /// A batch was stored: its sequence number, publish wall clock and newest event time.
-  void batch_stored(std::int64_t seq, std::int64_t publish_utime, Timestamp newest_event_us);
+  /// A batch was stored: its sequence number, publish wall clock (the sender's), receipt wall clock
+  /// (ours) and newest event time.
+  void batch_stored(std::int64_t seq, std::int64_t publish_utime, std::int64_t received_utime, Timestamp newest_event_us);
 
   struct Included {
     std::int64_t seq = -1;    ///< newest batch included so far (-1: none yet)
@@ -63,10 +67,22 @@ class LatencyTracker {
   [[nodiscard]] LatencySummary settled_summary() const { return settled_.run_summary(); }
   static constexpr std::int64_t kSettleUs = 1'000'000;
 
+  /// The publish clock's offset: the least (receipt - publish) over the last one to two windows,
+  /// transit plus how far the sender's clock is behind ours; none before the first batch.
+  [[nodiscard]] std::optional<std::int64_t> publish_clock_offset_us() const;
+  /// Batches whose latency was measured from their receipt, since the offset was beyond
+  /// kClocksApartUs either way.
+  [[nodiscard]] std::uint64_t measured_from_receipt() const { return from_receipt_; }
+  /// Transit on a network, and a camera's clock kept by NTP, are far below this.
+  static constexpr std::int64_t kClocksApartUs = 50'000;
+  static constexpr std::int64_t kOffsetWindowUs = 2'000'000;
+
  private:
   struct Pending {
     std::int64_t seq;
     std::int64_t utime;
+    std::int64_t received_utime;
+    bool from_receipt;
     Timestamp newest_event_us;
   };
   std::vector<Pending> ring_;
@@ -75,6 +91,10 @@ class LatencyTracker {
   LatencyStatistics settled_{0};  // a run histogram only: its per-period samples are never taken
   std::optional<std::int64_t> first_utime_;  // publish wall clock of the first batch stored
   Included newest_;
+  // The least delay of the current window (by receipt time) and of the one before it.
+  std::int64_t window_start_ = 0;
+  std::optional<std::int64_t> current_least_, previous_least_;
+  std::uint64_t from_receipt_ = 0;
 };
 
 }  // namespace evldt

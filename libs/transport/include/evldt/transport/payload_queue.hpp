@@ -22,15 +22,21 @@ namespace evldt {
 
 class PayloadQueue {
  public:
+  /// A queued payload and when it was received (wall clock, us).
+  struct Queued {
+    std::span<const std::uint8_t> bytes;
+    std::int64_t received_utime = 0;
+  };
+
   /// `slots` payloads at most, each slot touched for `slot_bytes` from the start. Throws
   /// std::invalid_argument for no slots.
   PayloadQueue(std::size_t slots, std::size_t slot_bytes);
 
-  /// Copies `payload` in. While every slot is full, waits for one (checking `stop` every 100 ms):
-  /// false if stopped first, the payload then not queued.
-  bool push(std::span<const std::uint8_t> payload, const std::atomic<bool>& stop);
+  /// Copies `payload`, received at `received_utime`, in. While every slot is full, waits for one
+  /// (checking `stop` every 100 ms): false if stopped first, the payload then not queued.
+  bool push(std::span<const std::uint8_t> payload, std::int64_t received_utime, const std::atomic<bool>& stop);
   /// The oldest payload, waiting up to `timeout` for one; it stays queued (and valid) until pop().
-  [[nodiscard]] std::optional<std::span<const std::uint8_t>> front(std::chrono::milliseconds timeout);
+  [[nodiscard]] std::optional<Queued> front(std::chrono::milliseconds timeout);
   /// Frees the slot of the payload front() returned.
   void pop();
 
@@ -41,6 +47,7 @@ class PayloadQueue {
   struct Slot {
     std::vector<std::uint8_t> bytes;  ///< never shrinks: its size is the slot's capacity
     std::size_t size = 0;
+    std::int64_t received_utime = 0;
   };
   std::vector<Slot> slots_;
   mutable std::mutex mutex_;
