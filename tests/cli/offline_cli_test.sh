@@ -215,6 +215,23 @@ diff <(same_run "$work/by_frames.txt") <(same_run "$work/by_epoch_frames.txt") >
   fail "an epoch clock scores differently from a clock from 0 (above)"
 grep -q "sensor 640x480: the size of the frames" "$work/by_epoch_frames.err" || fail "the sensor size not taken from the frames: $(cat "$work/by_epoch_frames.err")"
 echo "ok: --frames-gt and --per-second on Unix-epoch time stamps score as on a clock from 0, the sensor size from the frames"
+# --visible-only: multi-speed's rectangles slide sideways, so their top and bottom edges move along
+# themselves and give no events; scored without them (and what lies on them), F rises.
+"$eval" --scene multi-speed --duration-s 0.5 --visible-only --json "$work/visible.json" >"$work/visible.txt" 2>/dev/null ||
+  fail "--visible-only on multi-speed"
+python3 - "$work/visible.json" <<'PY' || fail "--visible-only: $(cat "$work/visible.txt")"
+import json, sys
+for run in json.load(open(sys.argv[1]))["runs"]:
+    visible = run["visible_only"]
+    assert visible["min_normal_speed"] == 2 and 0.5 < visible["visible_share"] < 0.8, visible
+    assert visible["accuracy"][0]["f"] > run["accuracy"][0]["f"] + 0.05, (run["run"], visible, run["accuracy"])
+PY
+grep -Eq '^multi-speed whole visible +0\.[0-9]{3}( +0\.[0-9]{3}){6}$' "$work/visible.txt" || fail "--visible-only rows: $(cat "$work/visible.txt")"
+if "$eval" --segments "$work/frames_seg.csv" --frames-gt "$work/frames" --visible-only >/dev/null 2>"$work/visible_frames.err"; then
+  fail "--visible-only with --frames-gt must be refused"
+fi
+grep -q "visible-only needs the true edges' motion" "$work/visible_frames.err" || fail "--visible-only refusal: $(cat "$work/visible_frames.err")"
+echo "ok: --visible-only scores what an events-only camera can see beside the full score; LSD's frames refused"
 # --overlay: a picture per scored frame, the predictions drawn over it (the same frames with no
 # prediction give other pictures).
 "$eval" --segments "$work/frames_seg.csv" --frames-gt "$work/frames" --overlay "$work/overlay" >/dev/null 2>&1 ||

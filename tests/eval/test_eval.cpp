@@ -334,6 +334,66 @@ TEST(StreamEvaluator, OneStepOfPredictionIsHeldForOnePeriodAndRecallIsOverAllSte
   EXPECT_EQ(coverage.predicted_steps_scored, 1u);
 }
 
+// ---- what an events-only camera can see -----------------------------------------------------------
+
+// Speeds along a piece are linear between its ends: the part below the threshold either way is hidden.
+TEST(SplitByNormalSpeed, HidesThePartOfAPieceMovingSlowerThanTheThreshold) {
+  const std::vector<Segment> truth = {{Point2(0, 0), Point2(100, 0)}, {Point2(0, 10), Point2(100, 10)},
+                                      {Point2(0, 20), Point2(100, 20)}, {Point2(0, 30), Point2(100, 30)}};
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<float> at_q0 = {-4, 1, 5, nan}, at_q1 = {4, -1, 3, 0};
+  std::vector<Segment> visible, hidden;
+  split_by_normal_speed(truth, at_q0, at_q1, 2, visible, hidden);
+  // A turning line: seen at both ends, not where it turns (|v| < 2 for s in (0.25, 0.75)); one that
+  // creeps: not at all; one that moves: whole; one of unknown speed: counted as seen.
+  ASSERT_EQ(visible.size(), 4u);
+  ASSERT_EQ(hidden.size(), 2u);
+  EXPECT_FLOAT_EQ(visible[0].q1.x(), 25);
+  EXPECT_FLOAT_EQ(hidden[0].q0.x(), 25);
+  EXPECT_FLOAT_EQ(hidden[0].q1.x(), 75);
+  EXPECT_FLOAT_EQ(visible[1].q0.x(), 75);
+  EXPECT_FLOAT_EQ(hidden[1].q0.y(), 10);
+  EXPECT_FLOAT_EQ(hidden[1].q1.x(), 100);
+  EXPECT_FLOAT_EQ(visible[2].q0.y(), 20);
+  EXPECT_FLOAT_EQ(visible[3].q0.y(), 30);
+  EXPECT_THROW(split_by_normal_speed(truth, at_q0, {}, 2, visible, hidden), std::invalid_argument);
+}
+
+// Two true lines, one moving across itself and one along itself (no events): the second and what is
+// predicted on it are left out of the visible score; a prediction on neither still counts against.
+TEST(StreamEvaluator, VisibleOnlyLeavesOutAnEdgeMovingAlongItselfAndWhatIsPredictedOnIt) {
+  const auto along_itself = [](std::size_t step) { return row_segment(40, 10 + static_cast<int>(step), 50 + static_cast<int>(step)); };
+  GroundTruthSteps truth = moving_truth();
+  truth.segments_at = [&](std::size_t index, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments = {moving_line(index), along_itself(index)};
+    ids = {3, 4};
+  };
+  for (const bool off_edge : {false, true}) {
+    SCOPED_TRACE(off_edge);
+    StreamEvaluator evaluator(kSensor, {0.01}, truth, std::llround(StreamEvaluator::kHoldPeriods * kGtPeriod));
+    evaluator.score_visible_only(2.0f);
+    for (int k = 0; k < kGtSteps; ++k) {
+      const auto index = static_cast<std::size_t>(k);
+      predict(evaluator, k * kGtPeriod, 1, {moving_line(index), off_edge ? row_segment(70, 10, 50) : along_itself(index)});
+    }
+    evaluator.finish();
+    const Prf full = evaluator.accuracy().summed_prf(0);
+    ASSERT_TRUE(evaluator.visible_accuracy().has_value());
+    const Prf visible = evaluator.visible_accuracy()->summed_prf(0);
+    EXPECT_EQ(evaluator.visible_truth_pixels(), evaluator.hidden_truth_pixels());  // two lines of 41 px
+    EXPECT_DOUBLE_EQ(visible.recall, 1.0);
+    if (off_edge) {
+      EXPECT_DOUBLE_EQ(full.recall, 0.5);
+      EXPECT_DOUBLE_EQ(visible.precision, 0.5);
+    } else {
+      EXPECT_DOUBLE_EQ(full.precision, 1.0);
+      EXPECT_DOUBLE_EQ(visible.precision, 1.0);
+    }
+  }
+  StreamEvaluator evaluator = moving_evaluator();
+  EXPECT_THROW(evaluator.score_visible_only(-1.0f), std::invalid_argument);
+}
+
 // The paper's view: counts summed up to each second. Steps at 0, 0.5, 1.5, 2 and 2.5 s, the same
 // line each; it is predicted exactly in the first second only.
 TEST(StreamEvaluator, CumulativePerSecondSumsTheStepsUpToEachSecond) {

@@ -161,7 +161,7 @@ def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
     truth_csv = boxes / "evt3" / "ground_truth.csv"
     run(OFFLINE, path, "-o", tmp_path / "segments.csv", "-q")
     run(EVAL, "--segments", tmp_path / "segments.csv", "--ground-truth", truth_csv, "--width", 240, "--height", 180,
-        "--json", tmp_path / "eval.json")
+        "--visible-only", "--json", tmp_path / "eval.json")
     (reference,) = json.loads((tmp_path / "eval.json").read_text())["runs"]
     rows = read_csv(tmp_path / "segments.csv")
     segments = np.zeros(len(rows), dtype=evldt.SEGMENT_DTYPE)
@@ -187,6 +187,14 @@ def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
     assert got["idf1"] == pytest.approx(reference["tracking"]["idf1"])
     assert got["vel_err_med"] == pytest.approx(reference["tracking"]["vel_err_med"])
     assert got["vel_rel_med"] == pytest.approx(reference["tracking"]["vel_rel_med"])
+    assert "visible_only" not in got
+    # What an events-only camera can see, as evldt-eval --visible-only scores it.
+    visible = evldt.evaluate(segments, truth, 240, 180, min_normal_speed=2)["visible_only"]
+    theirs = reference["visible_only"]
+    assert visible["visible_share"] == pytest.approx(theirs["visible_share"]) and 0.5 < visible["visible_share"] <= 1
+    for mine, expected in zip(visible["accuracy"], theirs["accuracy"]):
+        for key in ("tolerance", "precision", "recall", "f"):
+            assert mine[key] == pytest.approx(expected[key], abs=1e-12), key
     # The same run on a clock of Unix-epoch microseconds, as DV writes them (issue 49): the same figures.
     epoch = 1_600_000_000_000_000
     segments["t"] += epoch

@@ -42,6 +42,11 @@ struct Options {
   Timestamp output_period_us = 0;  ///< of a segment file; 0: its median step spacing
   double histogram_bin_ms = 50;
   bool per_second = false;
+  bool visible_only = false;
+  float min_normal_speed = 2.0f;  ///< px/s: slower true edges give no events (--visible-only)
+  [[nodiscard]] std::optional<float> visible_min_speed() const {
+    return visible_only ? std::optional<float>(min_normal_speed) : std::nullopt;
+  }
 };
 
 struct Report {
@@ -56,6 +61,8 @@ struct Report {
   LifetimeSummary lifetime;
   TrackingSummary tracking;
   std::optional<SupportSummary> support;  ///< whole lines: their support by the segments of their step
+  std::vector<Prf> visible;               ///< --visible-only: against the true edges moving fast enough to be seen
+  double visible_share = 0;               ///< of the true pixels, those moving fast enough
   std::vector<StreamEvaluator::Second> per_second;  ///< cumulative, at the first tolerance
   std::optional<Timestamp> seconds_origin;          ///< t0 of per_second
   std::vector<EdgeStep> edge_steps;       ///< with --edge-recall: each true edge at each step
@@ -75,6 +82,11 @@ Report make_report(const StreamEvaluator& evaluator) {
   r.lifetime = evaluator.lifetimes().summary();
   r.tracking = evaluator.tracking().summary();
   r.per_second = evaluator.per_second();
+  if (const auto& visible = evaluator.visible_accuracy()) {
+    for (std::size_t i = 0; i < visible->tolerance_fractions().size(); ++i) r.visible.push_back(visible->summed_prf(i));
+    const auto seen = static_cast<double>(evaluator.visible_truth_pixels()), unseen = static_cast<double>(evaluator.hidden_truth_pixels());
+    r.visible_share = seen + unseen > 0 ? seen / (seen + unseen) : std::numeric_limits<double>::quiet_NaN();
+  }
   r.seconds_origin = evaluator.seconds_origin();
   if (evaluator.edge_recall()) r.edge_steps = evaluator.edge_recall()->steps();
   return r;
@@ -151,7 +163,8 @@ StreamEvaluator evaluate_files(const Options& options, std::vector<SegmentRow> r
                    static_cast<double>(span->second) * 1e-6);
     }
   }
-  return evaluate_segment_rows(std::move(rows), std::move(truth), sensor, options.tolerances, options.output_period_us);
+  return evaluate_segment_rows(std::move(rows), std::move(truth), sensor, options.tolerances, options.output_period_us,
+                               options.visible_min_speed());
 }
 
 // An undefined ratio (nothing predicted, or no ground truth) is "n/a", never a perfect or zero score.
@@ -181,6 +194,24 @@ void print_table(const std::vector<Report>& reports, const Options& options) {
                 figure(r.tracking.coverage).c_str(), figure(r.tracking.ids_per_line, 1).c_str(),
                 static_cast<unsigned long long>(r.tracking.id_switches), figure(r.tracking.idf1).c_str(),
                 figure(r.tracking.velocity_error_median, 1).c_str(), figure(r.tracking.velocity_relative_median).c_str());
+  }
+}
+
+// --visible-only: the runs again, scored against the true edges an events-only camera can see.
+void print_visible(const std::vector<Report>& reports, const Options& options) {
+  std::printf("scored against what an events-only camera can see: the true edges moving across themselves at %g px/s or more\n",
+              static_cast<double>(options.min_normal_speed));
+  std::printf("%-32s %8s", "run", "visible");
+  for (const double tol : options.tolerances) {
+    const std::string at = fmt::format("@{:g}%", tol * 100);
+    std::printf("  %6s  %6s  %6s", ("P" + at).c_str(), ("R" + at).c_str(), ("F" + at).c_str());
+  }
+  std::printf("\n");
+  for (const Report& r : reports) {
+    if (r.visible.empty()) continue;
+    std::printf("%-32s %8s", (r.label + " visible").c_str(), figure(r.visible_share).c_str());
+    for (const Prf& p : r.visible) std::printf("  %6s  %6s  %6s", figure(p.precision).c_str(), figure(p.recall).c_str(), figure(p.f).c_str());
+    std::printf("\n");
   }
 }
 
@@ -301,6 +332,15 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
       json.key("recall").value(r.summed[i].recall).key("f").value(r.summed[i].f).end_object();
     }
     json.end_array();
+    if (!r.visible.empty()) {
+      json.key("visible_only").begin_object().key("min_normal_speed").value(static_cast<double>(options.min_normal_speed));
+      json.key("visible_share").value(r.visible_share).key("accuracy").begin_array();
+      for (std::size_t i = 0; i < r.visible.size(); ++i) {
+        json.begin_object().key("tolerance").value(options.tolerances[i]).key("precision").value(r.visible[i].precision);
+        json.key("recall").value(r.visible[i].recall).key("f").value(r.visible[i].f).end_object();
+      }
+      json.end_array().end_object();
+    }
     json.key("cumulative_per_second").begin_array();
     for (const StreamEvaluator::Second& second : r.per_second) {
       const Prf& p = second.cumulative;
@@ -401,6 +441,11 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     spdlog::error("--edge-recall scores the pipeline's run on --scene (without --segments)");
     return 1;
   }
+  if (options.visible_only && !options.frames_gt.empty()) {
+    spdlog::error("--visible-only needs the true edges' motion: simulated ground truth (--scene, or --ground-truth written "
+                  "by evldt-sim), not LSD's lines of --frames-gt");
+    return 1;
+  }
   if (!options.overlay.empty() && (options.segments.empty() || options.frames_gt.empty())) {
     spdlog::error("--overlay draws the frames of --frames-gt with the lines of --segments: give both");
     return 1;
@@ -464,6 +509,10 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
         last->keep_edge_recall(middle);
         whole.keep_edge_recall(middle);
       }
+      if (options.visible_only) {
+        last->score_visible_only(options.min_normal_speed);
+        whole.score_visible_only(options.min_normal_speed);
+      }
       const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole, options.thin);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, result.events, wall);
@@ -495,6 +544,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   for (const Report& r : reports) {
     if (r.support) print_support(r.label, *r.support);
   }
+  if (options.visible_only) print_visible(reports, options);
   if (options.per_second) print_per_second(reports, options);
   if (!options.edge_recall.empty()) write_edge_recall(reports, options.edge_recall);
   if (!options.json.empty()) write_json(reports, options);
@@ -547,6 +597,12 @@ int main(int argc, char** argv) {
   app.add_flag("--per-second", options.per_second,
                "Also print the paper's view: precision and recall summed up to each second, over the first 10 s (the JSON "
                "has every second)");
+  app.add_flag("--visible-only", options.visible_only,
+               "Also score against what an events-only camera can see: simulated true edges (--scene, or evldt-sim's "
+               "ground-truth CSV) where they move across themselves at --min-normal-speed or more; predicted pixels near "
+               "the slower ones and near no faster one count neither way. A second row per run; the full one stays the headline");
+  app.add_option("--min-normal-speed", options.min_normal_speed, "With --visible-only: px/s (default 2)")
+      ->check(CLI::Range(0.0f, 1e6f));
   app.add_option("--lsd-min-length", options.lsd.min_length_px, "With --frames-gt: LSD segments shorter than this (px) are dropped")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.0, 10000.0));

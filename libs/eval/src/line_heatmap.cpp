@@ -152,6 +152,19 @@ void HeatmapMatcher::matched_ground_truth(std::vector<std::uint8_t>& map) const 
   }
 }
 
+void HeatmapMatcher::matched_predicted(std::span<const std::uint8_t> predicted_map, std::vector<std::uint8_t>& map) const {
+  check_map_size(predicted_map, sensor_, "predicted");
+  map.assign(pixel_count(sensor_), 0);
+  // The predicted pixels were numbered in the order for_each_line_pixel visits them.
+  std::uint32_t u = 0;
+  for_each_line_pixel(predicted_map, sensor_.width, [&](int x, int y) {
+    if (u < mate_of_predicted_.size() && mate_of_predicted_[u] != kNone) {
+      map[static_cast<std::size_t>(y) * static_cast<std::size_t>(sensor_.width) + static_cast<std::size_t>(x)] = 1;
+    }
+    ++u;
+  });
+}
+
 MatchCounts HeatmapMatcher::match_maps(std::span<const std::uint8_t> predicted_map,
                                        std::span<const std::uint8_t> ground_truth_map) {
   check_map_size(predicted_map, sensor_, "predicted");

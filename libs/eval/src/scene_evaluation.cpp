@@ -97,6 +97,15 @@ void StreamEvaluator::keep_edge_recall(std::optional<Timestamp> picture_at_us) {
   edge_recall_.emplace(matchers_.front().sensor(), picture_at_us);
 }
 
+void StreamEvaluator::score_visible_only(float min_normal_speed) {
+  if (!(min_normal_speed >= 0)) throw std::invalid_argument("the least speed across itself of a visible edge must not be negative");
+  std::vector<double> fractions(accuracy_.tolerance_fractions().begin(), accuracy_.tolerance_fractions().end());
+  visible_accuracy_.emplace(fractions);
+  visible_matcher_.emplace(matchers_.front().sensor());
+  visible_counts_.resize(matchers_.size());
+  min_normal_speed_ = min_normal_speed;
+}
+
 void StreamEvaluator::score_steps_before(Timestamp until) {
   const std::vector<Timestamp>& times = ground_truth_.times;
   for (; next_step_ < times.size() && times[next_step_] < until; ++next_step_) {
@@ -112,7 +121,7 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
     const Timestamp t = times[next_step_];
     add_to_second(t, counts_[0]);
     const bool with_velocities = use_held && !held_velocities_.empty();
-    if (with_velocities) truth_velocities_at(next_step_);
+    if (with_velocities) normal_velocities_at(next_step_, 0.5f, truth_velocities_);
     tracking_.add_step(t, predicted_ids, predicted, truth_ids_, truth_,
                        with_velocities ? std::span<const float>(held_velocities_) : std::span<const float>(),
                        with_velocities ? std::span<const float>(truth_velocities_) : std::span<const float>());
@@ -120,15 +129,24 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
       matchers_.front().matched_ground_truth(matched_map_);
       edge_recall_->add_step(t, truth_, truth_ids_, predicted, matched_map_);
     }
+    if (visible_accuracy_) {
+      normal_velocities_at(next_step_, 0.0f, speed_at_q0_);
+      normal_velocities_at(next_step_, 1.0f, speed_at_q1_);
+      split_by_normal_speed(truth_, speed_at_q0_, speed_at_q1_, min_normal_speed_, visible_truth_, hidden_truth_);
+      visible_matcher_->match(predicted, visible_truth_, hidden_truth_, matchers_, visible_counts_);
+      visible_accuracy_->add_step(visible_counts_, predicted.size(), visible_truth_.size());
+      visible_pixels_ += visible_matcher_->visible_pixels();
+      hidden_pixels_ += visible_matcher_->hidden_pixels();
+    }
   }
 }
 
-void StreamEvaluator::truth_velocities_at(std::size_t index) {
-  // Where each line of this step crosses the normal through the centre of its first piece, at a
+void StreamEvaluator::normal_velocities_at(std::size_t index, float along, std::vector<float>& velocities) {
+  // Where each line of this step crosses the normal through the point of its piece, at a
   // neighbouring step: the distance along that normal (NaN where the line is not seen).
   const std::size_t pieces = truth_.size();
-  const auto crossings = [&](std::size_t step, std::vector<double>& along) {
-    along.assign(pieces, std::numeric_limits<double>::quiet_NaN());
+  const auto crossings = [&](std::size_t step, std::vector<double>& distances) {
+    distances.assign(pieces, std::numeric_limits<double>::quiet_NaN());
     ground_truth_.segments_at(step, neighbour_truth_, neighbour_ids_);
     for (std::size_t piece = 0; piece < pieces; ++piece) {
       const auto it = std::find(neighbour_ids_.begin(), neighbour_ids_.end(), truth_ids_[piece]);
@@ -137,22 +155,22 @@ void StreamEvaluator::truth_velocities_at(std::size_t index) {
       const Point2 n = unit_normal(truth_[piece]), m = unit_normal(there);
       const double facing = m.dot(n);
       if (std::abs(facing) < 0.5) continue;  // turned by more than 60 degrees in a step: no crossing to speak of
-      along[piece] = m.dot(there.q0 - truth_[piece].centre()) / facing;
+      const Point2 point = truth_[piece].q0 + along * (truth_[piece].q1 - truth_[piece].q0);
+      distances[piece] = m.dot(there.q0 - point) / facing;
     }
   };
   const std::vector<Timestamp>& times = ground_truth_.times;
   const std::size_t before = index > 0 ? index - 1 : index, after = index + 1 < times.size() ? index + 1 : index;
-  std::vector<double> at_before, at_after;
-  crossings(before, at_before);
-  crossings(after, at_after);
-  truth_velocities_.assign(pieces, std::numeric_limits<float>::quiet_NaN());
+  crossings(before, crossings_before_);
+  crossings(after, crossings_after_);
+  velocities.assign(pieces, std::numeric_limits<float>::quiet_NaN());
   for (std::size_t piece = 0; piece < pieces; ++piece) {
     // A neighbour where the line is not seen gives way to this step itself (crossing at 0).
-    double from = at_before[piece], to = at_after[piece];
+    double from = crossings_before_[piece], to = crossings_after_[piece];
     Timestamp t_from = times[before], t_to = times[after];
     if (!std::isfinite(from)) from = 0, t_from = times[index];
     if (!std::isfinite(to)) to = 0, t_to = times[index];
-    if (t_to > t_from) truth_velocities_[piece] = static_cast<float>((to - from) / (static_cast<double>(t_to - t_from) * 1e-6));
+    if (t_to > t_from) velocities[piece] = static_cast<float>((to - from) / (static_cast<double>(t_to - t_from) * 1e-6));
   }
 }
 
@@ -232,10 +250,12 @@ Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_
 }
 
 StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthSteps truth, SensorSize sensor,
-                                      std::vector<double> tolerance_fractions, Timestamp output_period_us) {
+                                      std::vector<double> tolerance_fractions, Timestamp output_period_us,
+                                      std::optional<float> visible_min_normal_speed) {
   std::stable_sort(rows.begin(), rows.end(), [](const SegmentRow& a, const SegmentRow& b) { return a.t_us < b.t_us; });
   const Timestamp hold_us = prediction_hold_us(rows, output_period_us, truth.times);
   StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth), hold_us);
+  if (visible_min_normal_speed) evaluator.score_visible_only(*visible_min_normal_speed);
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted;
   std::vector<float> velocities;

@@ -134,12 +134,15 @@ class Pipeline:
         return self._impl.counters()
 
 
-def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), output_period_us=0):
+def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), output_period_us=0, min_normal_speed=None):
     """evldt-eval's figures for predicted segments (SEGMENT_DTYPE, or any structured array with t,
     id, x0, y0, x1, y1, and normal_velocity if known) against ground truth (GROUND_TRUTH_DTYPE: t, gt_id, x0, y0, x1, y1):
     precision, recall and F at each tolerance (a fraction of the image diagonal), id lifetimes and
     the tracking metrics; vel_err_med and vel_rel_med compare normal velocities (None: the rows
-    carry none). output_period_us 0: the median spacing of the predicted steps."""
+    carry none). output_period_us 0: the median spacing of the predicted steps. With
+    min_normal_speed (px/s; evldt-eval --visible-only's 2 is the usual), also "visible_only": the
+    score against the true edges moving across themselves at that speed or more, and their share
+    of the true pixels."""
     predicted = np.zeros(len(segments), dtype=SEGMENT_DTYPE)
     for field in ("t", "id", "x0", "y0", "x1", "y1"):
         predicted[field] = segments[field]
@@ -149,7 +152,7 @@ def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), out
     for field in GROUND_TRUTH_DTYPE.names:
         truth[field] = ground_truth[field]
     return _evldt.evaluate(predicted, truth, int(width), int(height), [float(t) for t in tolerances],
-                           int(output_period_us))
+                           int(output_period_us), None if min_normal_speed is None else float(min_normal_speed))
 
 
 def read_frames(path, width, height, topic=""):

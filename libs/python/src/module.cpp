@@ -281,7 +281,9 @@ py::dict prf_dict(const Prf& prf) {
 
 /// evldt-eval's figures of predicted segments against ground truth.
 py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<GroundTruthRecord>& ground_truth,
-                  int width, int height, const std::vector<double>& tolerances, Timestamp output_period_us) {
+                  int width, int height, const std::vector<double>& tolerances, Timestamp output_period_us,
+                  std::optional<float> min_normal_speed) {
+  if (min_normal_speed && !(*min_normal_speed >= 0)) throw py::value_error("min_normal_speed must not be negative");
   std::vector<SegmentRow> rows;
   const auto predicted = segments.unchecked<1>();
   rows.reserve(static_cast<std::size_t>(predicted.shape(0)));
@@ -304,7 +306,7 @@ py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<
     py::gil_scoped_release unlocked;
     GroundTruthSteps steps = csv_ground_truth_steps(truth_rows);
     evaluator.emplace(evaluate_segment_rows(std::move(rows), std::move(steps), SensorSize{width, height}, tolerances,
-                                            output_period_us));
+                                            output_period_us, min_normal_speed));
   }
   py::dict out;
   py::list by_tolerance;
@@ -315,6 +317,21 @@ py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<
     by_tolerance.append(entry);
   }
   out["accuracy"] = by_tolerance;
+  if (const auto& visible = evaluator->visible_accuracy()) {
+    py::dict visible_only;
+    py::list visible_by_tolerance;
+    for (std::size_t i = 0; i < tolerances.size(); ++i) {
+      py::dict entry = prf_dict(visible->summed_prf(i));
+      entry["tolerance"] = tolerances[i];
+      visible_by_tolerance.append(entry);
+    }
+    const auto seen = static_cast<double>(evaluator->visible_truth_pixels());
+    const auto unseen = static_cast<double>(evaluator->hidden_truth_pixels());
+    visible_only["min_normal_speed"] = *min_normal_speed;
+    visible_only["visible_share"] = seen + unseen > 0 ? seen / (seen + unseen) : std::numeric_limits<double>::quiet_NaN();
+    visible_only["accuracy"] = visible_by_tolerance;
+    out["visible_only"] = visible_only;
+  }
   out["steps"] = accuracy.steps();
   out["mean_predicted_segments"] = accuracy.mean_predicted_segments();
   out["mean_ground_truth_segments"] = accuracy.mean_ground_truth_segments();
@@ -446,7 +463,7 @@ PYBIND11_MODULE(_evldt, m) {
       .def_property_readonly("undecodable", &Subscriber::undecodable);
 
   m.def("evaluate", &evaluate, py::arg("segments"), py::arg("ground_truth"), py::arg("width"), py::arg("height"),
-        py::arg("tolerances"), py::arg("output_period_us"));
+        py::arg("tolerances"), py::arg("output_period_us"), py::arg("min_normal_speed") = py::none());
   m.def("simulate", &simulate, py::arg("flags"), py::arg("gt_period_us"));
   m.def("read_frames", &read_frames, py::arg("path"), py::arg("width"), py::arg("height"), py::arg("topic") = "");
 }

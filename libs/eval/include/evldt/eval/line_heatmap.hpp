@@ -82,6 +82,9 @@ class HeatmapMatcher {
   /// The ground-truth pixels the last match paired with a predicted one, as a W*H row-major map
   /// (resized here): 1 where matched.
   void matched_ground_truth(std::vector<std::uint8_t>& map) const;
+  /// The pixels of `predicted_map` (the one the last match_maps was given) that it paired with a
+  /// ground-truth pixel, as a W*H row-major map (resized here): 1 where matched.
+  void matched_predicted(std::span<const std::uint8_t> predicted_map, std::vector<std::uint8_t>& map) const;
 
   [[nodiscard]] SensorSize sensor() const { return sensor_; }
   [[nodiscard]] double tolerance_px() const { return tolerance_px_; }

@@ -13,6 +13,7 @@
 #include "evldt/eval/edge_recall.hpp"
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/eval/tracking_metrics.hpp"
+#include "evldt/eval/visible_score.hpp"
 #include "evldt/eval/whole_line_support.hpp"
 #include "evldt/lines/deterministic_pipeline.hpp"
 #include "evldt/lines/segment_csv.hpp"
@@ -96,20 +97,37 @@ class StreamEvaluator {
   void keep_edge_recall(std::optional<Timestamp> picture_at_us = std::nullopt);
   /// The recall per edge, when kept.
   [[nodiscard]] const std::optional<EdgeRecall>& edge_recall() const { return edge_recall_; }
+  /// Also score against only what an events-only camera can see (visible_score.hpp): the true edges
+  /// where they move across themselves at `min_normal_speed` px/s or more, the speed from the lines'
+  /// places at the neighbouring steps (before any step; throws std::invalid_argument if negative).
+  void score_visible_only(float min_normal_speed);
+  /// That score, when asked for.
+  [[nodiscard]] const std::optional<EvaluationAccumulator>& visible_accuracy() const { return visible_accuracy_; }
+  /// Of the true pixels over all steps, those moving fast enough to be seen and those not (with
+  /// score_visible_only).
+  [[nodiscard]] std::uint64_t visible_truth_pixels() const { return visible_pixels_; }
+  [[nodiscard]] std::uint64_t hidden_truth_pixels() const { return hidden_pixels_; }
   [[nodiscard]] const GroundTruthSteps& ground_truth() const { return ground_truth_; }
 
  private:
   /// Scores every ground-truth step before `until` against the held prediction.
   void score_steps_before(Timestamp until);
   /// The true lines' velocities across themselves at step `index`, one per piece of truth_ (NaN
-  /// where the line is seen at neither neighbouring step): central differences of where each line
-  /// lies along the normal of its first piece, through that piece's centre.
-  void truth_velocities_at(std::size_t index);
+  /// where the line is seen at neither neighbouring step), at the point `along` (0: q0, 1: q1) of
+  /// each piece: central differences of where each line lies along the piece's normal through it.
+  void normal_velocities_at(std::size_t index, float along, std::vector<float>& velocities);
   /// Adds a step's counts at the first tolerance to its second.
   void add_to_second(Timestamp t, const MatchCounts& counts);
 
   std::vector<HeatmapMatcher> matchers_;
   EvaluationAccumulator accuracy_;
+  std::optional<EvaluationAccumulator> visible_accuracy_;
+  std::optional<VisibleOnlyMatcher> visible_matcher_;
+  float min_normal_speed_ = 0;
+  std::vector<float> speed_at_q0_, speed_at_q1_;
+  std::vector<Segment> visible_truth_, hidden_truth_;
+  std::vector<MatchCounts> visible_counts_;
+  std::uint64_t visible_pixels_ = 0, hidden_pixels_ = 0;
   LifetimeTracker lifetimes_;
   TrackingEvaluator tracking_;
   std::vector<MatchCounts> per_second_;  // first tolerance, by second of the step time
@@ -127,6 +145,7 @@ class StreamEvaluator {
   std::vector<float> truth_velocities_;
   std::vector<Segment> neighbour_truth_;
   std::vector<std::uint64_t> neighbour_ids_;
+  std::vector<double> crossings_before_, crossings_after_;
   std::vector<std::uint64_t> truth_ids_;
   std::vector<Segment> truth_;
   std::vector<MatchCounts> counts_;
@@ -136,16 +155,18 @@ class StreamEvaluator {
   std::vector<std::uint8_t> matched_map_;  // scratch of the edge recall
 };
 
-/// Scores predicted segment rows (of a CSV, a log or Python; any order, sorted by time here) on
-/// ground-truth steps with StreamEvaluator's rule and a hold of kHoldPeriods output periods.
-/// output_period_us 0: the median spacing of the predicted steps (of the ground truth's, with fewer
-/// than two).
 /// How long a predicted step of `rows` (any order) holds when scored: StreamEvaluator::kHoldPeriods of
 /// `output_period_us`, else of the median spacing of their steps, else (fewer than two steps) of the
 /// ground truth's.
 Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_period_us, std::span<const Timestamp> truth_times);
+/// Scores predicted segment rows (of a CSV, a log or Python; any order, sorted by time here) on
+/// ground-truth steps with StreamEvaluator's rule and a hold of kHoldPeriods output periods.
+/// output_period_us 0: the median spacing of the predicted steps (of the ground truth's, with fewer
+/// than two). With visible_min_normal_speed, also scores what an events-only camera can see
+/// (StreamEvaluator::score_visible_only).
 StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthSteps truth, SensorSize sensor,
-                                      std::vector<double> tolerance_fractions, Timestamp output_period_us);
+                                      std::vector<double> tolerance_fractions, Timestamp output_period_us,
+                                      std::optional<float> visible_min_normal_speed = std::nullopt);
 
 /// The nominal output period of a prediction: the median spacing of its distinct step times, or 0
 /// with fewer than two.
