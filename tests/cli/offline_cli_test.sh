@@ -227,11 +227,19 @@ for run in json.load(open(sys.argv[1]))["runs"]:
     assert visible["accuracy"][0]["f"] > run["accuracy"][0]["f"] + 0.05, (run["run"], visible, run["accuracy"])
 PY
 grep -Eq '^multi-speed whole visible +0\.[0-9]{3}( +0\.[0-9]{3}){6}$' "$work/visible.txt" || fail "--visible-only rows: $(cat "$work/visible.txt")"
-if "$eval" --segments "$work/frames_seg.csv" --frames-gt "$work/frames" --visible-only >/dev/null 2>"$work/visible_frames.err"; then
-  fail "--visible-only with --frames-gt must be refused"
+# Against LSD on frames: a line is seen where the recording's events (here the folder's events.txt)
+# fell along it around the frame's time.
+"$eval" --segments "$work/frames_seg.csv" --frames-gt "$work/frames" --width 640 --height 480 --visible-only \
+  >"$work/visible_frames.txt" 2>"$work/visible_frames.err" || fail "--visible-only with --frames-gt: $(cat "$work/visible_frames.err")"
+grep -Eq "[0-9]+ of [0-9]+ LSD lines have events of .*frames/events.txt along them" "$work/visible_frames.err" ||
+  fail "--visible-only, the LSD lines seen: $(cat "$work/visible_frames.err")"
+grep -Eq '^frames_seg.csv visible +[01]\.[0-9]{3}( +[01]\.[0-9]{3}){6}$' "$work/visible_frames.txt" || fail "--visible-only rows on frames: $(cat "$work/visible_frames.txt")"
+if "$eval" --scene three-lines-fast --duration-s 0.2 --frames-gt "$work/frames" --visible-only >/dev/null 2>"$work/visible_scene_frames.err"; then
+  fail "--visible-only on a scene run against frames must be refused"
 fi
-grep -q "visible-only needs the true edges' motion" "$work/visible_frames.err" || fail "--visible-only refusal: $(cat "$work/visible_frames.err")"
-echo "ok: --visible-only scores what an events-only camera can see beside the full score; LSD's frames refused"
+grep -q "visible-only with --frames-gt scores a recording's --segments" "$work/visible_scene_frames.err" ||
+  fail "--visible-only refusal: $(cat "$work/visible_scene_frames.err")"
+echo "ok: --visible-only scores what an events-only camera can see beside the full score, on a scene and on frames"
 # --overlay: a picture per scored frame, the predictions drawn over it (the same frames with no
 # prediction give other pictures).
 "$eval" --segments "$work/frames_seg.csv" --frames-gt "$work/frames" --overlay "$work/overlay" >/dev/null 2>&1 ||
@@ -280,6 +288,13 @@ if [[ -f $real ]]; then
     grep -Eq "^real_$run.csv +t0 1633953690 s: +0-1 s n/a / 0\.000 +1-2 s 0\.[0-9]{3} / 0\.[0-9]{3}$" "$work/real_$run.txt" ||
       fail "per second on $real: $(cat "$work/real_$run.txt")"
     [[ $(ls "$work/real_overlay_$run" | grep -c '\.png$') -eq 3 ]] || fail "3 pictures of $real"
+    # What its events show: the LSD lines along which they fell within 10 ms of each frame.
+    "$eval" --segments "$work/real_$run.csv" --frames-gt "$real" --visible-only --overlay "$work/real_visible_$run" \
+      >"$work/real_visible_$run.txt" 2>"$work/real_visible_$run.err" || fail "--visible-only on $real: $(cat "$work/real_visible_$run.err")"
+    grep -Eq "^real_$run.csv visible +0\.[0-9]{3}( +[01]\.[0-9]{3}){6}$" "$work/real_visible_$run.txt" ||
+      fail "--visible-only on $real: $(cat "$work/real_visible_$run.txt")"
+    cmp -s "$work/real_overlay_$run/step_00002.png" "$work/real_visible_$run/step_00002.png" &&
+      fail "--visible-only drew the LSD lines without events as the others"
   done
   echo "ok: $real scored against LSD on its 3 frames, segments and whole lines, per second, with pictures"
 else

@@ -688,6 +688,37 @@ TEST_F(FramesTest, VideoFramesOnTheClockOfTheEventsEmulatedFromThem) {
   EXPECT_THROW(small->next(), FrameError);
 }
 
+// What an events-only camera can see of LSD's lines: those along which events fell within the
+// window around the frame's time, in half or more of their pixels; read batch by batch, once.
+TEST(EventSupport, ALineIsSeenWhereEventsFellAlongItAroundTheFrame) {
+  const Segment upper{Point2(10.5f, 10.5f), Point2(40.5f, 10.5f)}, lower{Point2(10.5f, 30.5f), Point2(40.5f, 30.5f)};
+  GroundTruthSteps truth;
+  truth.times = {100'000, 200'000};
+  truth.segments_at = [&](std::size_t, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
+    segments = {upper, lower};
+    ids = {1, 2};
+  };
+  std::vector<EventBatch> batches(2);
+  const auto along = [&](EventBatch& batch, Timestamp t, int y, int x_from, int x_to) {
+    for (int x = x_from; x <= x_to; ++x) batch.push_back(t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), 1);
+  };
+  along(batches[0], 95'000, 10, 10, 40);   // the upper line, 5 ms before the first frame
+  along(batches[0], 150'000, 30, 10, 40);  // the lower line, 50 ms from either frame: too far
+  batches[0].push_back(160'000, 1000, 10, 1);  // off the sensor: passed over
+  along(batches[1], 198'000, 11, 10, 20);  // a third of the upper line, 1 px off it: not half
+  along(batches[1], 205'000, 29, 10, 40);  // the lower line, 1 px off it, 5 ms after the second frame
+  std::size_t next = 0;
+  const auto supported = event_supported_pieces(truth, {64, 48}, EventSupportRule{}, [&](EventBatch& batch) {
+    if (next == batches.size()) return false;
+    batch = batches[next++];
+    return true;
+  });
+  ASSERT_EQ(supported.size(), 2u);
+  EXPECT_EQ(supported[0], (std::vector<std::uint8_t>{1, 0}));
+  EXPECT_EQ(supported[1], (std::vector<std::uint8_t>{0, 1}));
+  EXPECT_EQ(next, batches.size());
+}
+
 TEST_F(FramesTest, LsdFindsTheSidesOfASquare) {
   const std::vector<Segment> found = lsd_segments(square(20), LsdParams{});
   int vertical_at_left = 0;

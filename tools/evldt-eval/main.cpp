@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <cstdio>
 #include <fstream>
 #include <spdlog/spdlog.h>
@@ -22,6 +23,7 @@
 #include "evldt/frames/frame_reader.hpp"
 #include "evldt/lines/segment_csv.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
+#include "evldt/sources/event_source.hpp"
 #include "evldt/transport/lcm_log.hpp"
 
 namespace {
@@ -44,10 +46,42 @@ struct Options {
   bool per_second = false;
   bool visible_only = false;
   float min_normal_speed = 2.0f;  ///< px/s: slower true edges give no events (--visible-only)
-  [[nodiscard]] std::optional<float> visible_min_speed() const {
-    return visible_only ? std::optional<float>(min_normal_speed) : std::nullopt;
-  }
+  std::filesystem::path events;   ///< --visible-only with --frames-gt: the events that go with the frames
+  EventSupportRule support;
 };
+
+// The events of --frames-gt's recording: --events, else the frames' own file (AEDAT 4.0, a bag, an
+// HDF5 file hold both), or the events.txt of an Event Camera Dataset folder.
+std::filesystem::path events_of_frames(const Options& options) {
+  if (!options.events.empty()) return options.events;
+  if (std::filesystem::is_directory(options.frames_gt)) return options.frames_gt / "events.txt";
+  return options.frames_gt;
+}
+
+// --visible-only: the rule for the ground truth of these options. Simulated edges are seen by their
+// speed; LSD's lines of frames by the recording's events along them (read once, here).
+std::optional<VisibleOnly> visible_rule(const Options& options, const GroundTruthSteps& truth, SensorSize sensor) {
+  if (!options.visible_only) return std::nullopt;
+  if (options.frames_gt.empty()) return VisibleOnly{.min_normal_speed = options.min_normal_speed};
+  const std::filesystem::path path = events_of_frames(options);
+  const auto source = open_recording(path, std::nullopt, "", std::numeric_limits<Timestamp>::max() / 4);
+  auto supported = std::make_shared<std::vector<std::vector<std::uint8_t>>>(
+      event_supported_pieces(truth, sensor, options.support, [&](EventBatch& batch) { return source->read(batch); }));
+  std::size_t lines = 0, seen = 0;
+  for (const auto& step : *supported) {
+    lines += step.size();
+    seen += static_cast<std::size_t>(std::count(step.begin(), step.end(), std::uint8_t{1}));
+  }
+  spdlog::info("{} of {} LSD lines have events of {} along them (half or more of their pixels within +-{:.1f} ms)", seen,
+               lines, path.string(), static_cast<double>(options.support.half_window_us) * 1e-3);
+  return VisibleOnly{.split = [supported](std::size_t index, std::span<const Segment> pieces, std::vector<Segment>& visible,
+                                          std::vector<Segment>& hidden) {
+    visible.clear();
+    hidden.clear();
+    const std::vector<std::uint8_t>& flags = (*supported)[index];
+    for (std::size_t k = 0; k < pieces.size(); ++k) (k < flags.size() && flags[k] ? visible : hidden).push_back(pieces[k]);
+  }};
+}
 
 struct Report {
   std::string label;
@@ -163,8 +197,9 @@ StreamEvaluator evaluate_files(const Options& options, std::vector<SegmentRow> r
                    static_cast<double>(span->second) * 1e-6);
     }
   }
+  std::optional<VisibleOnly> visible = visible_rule(options, truth, sensor);
   return evaluate_segment_rows(std::move(rows), std::move(truth), sensor, options.tolerances, options.output_period_us,
-                               options.visible_min_speed());
+                               std::move(visible));
 }
 
 // An undefined ratio (nothing predicted, or no ground truth) is "n/a", never a perfect or zero score.
@@ -258,7 +293,7 @@ void write_overlay_pictures(const Options& options, const StreamEvaluator& score
   const Timestamp whole_line_hold = prediction_hold_us(whole_lines, options.output_period_us, scored.ground_truth().times);
   const auto frames = open_frames(options.frames_gt, options.frames_topic, sensor);
   const std::size_t pictures = write_overlays(options.overlay, *frames, scored.ground_truth(), {segments, scored.hold_us()},
-                                              {whole_lines, whole_line_hold});
+                                              {whole_lines, whole_line_hold}, scored.visibility_split());
   spdlog::info("wrote {} pictures of the scored frames to {}", pictures, options.overlay.string());
 }
 
@@ -441,9 +476,8 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     spdlog::error("--edge-recall scores the pipeline's run on --scene (without --segments)");
     return 1;
   }
-  if (options.visible_only && !options.frames_gt.empty()) {
-    spdlog::error("--visible-only needs the true edges' motion: simulated ground truth (--scene, or --ground-truth written "
-                  "by evldt-sim), not LSD's lines of --frames-gt");
+  if (options.visible_only && !options.frames_gt.empty() && options.segments.empty()) {
+    spdlog::error("--visible-only with --frames-gt scores a recording's --segments: LSD's lines are seen by its events");
     return 1;
   }
   if (!options.overlay.empty() && (options.segments.empty() || options.frames_gt.empty())) {
@@ -510,8 +544,8 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
         whole.keep_edge_recall(middle);
       }
       if (options.visible_only) {
-        last->score_visible_only(options.min_normal_speed);
-        whole.score_visible_only(options.min_normal_speed);
+        last->score_visible_only({.min_normal_speed = options.min_normal_speed});
+        whole.score_visible_only({.min_normal_speed = options.min_normal_speed});
       }
       const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole, options.thin);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -599,10 +633,20 @@ int main(int argc, char** argv) {
                "has every second)");
   app.add_flag("--visible-only", options.visible_only,
                "Also score against what an events-only camera can see: simulated true edges (--scene, or evldt-sim's "
-               "ground-truth CSV) where they move across themselves at --min-normal-speed or more; predicted pixels near "
-               "the slower ones and near no faster one count neither way. A second row per run; the full one stays the headline");
+               "ground-truth CSV) where they move across themselves at --min-normal-speed or more; with --frames-gt, LSD's "
+               "lines along which the recording's events fell (--support-window-ms); predicted pixels left unmatched near "
+               "the others count neither way. A second row per run; the full one stays the headline");
   app.add_option("--min-normal-speed", options.min_normal_speed, "With --visible-only: px/s (default 2)")
       ->check(CLI::Range(0.0f, 1e6f));
+  app.add_option("--events", options.events,
+                 "With --visible-only and --frames-gt: the recording whose events go with the frames (default: the "
+                 "--frames-gt file itself, or the events.txt of its folder)");
+  app.add_option_function<double>(
+         "--support-window-ms",
+         [&](double ms) { options.support.half_window_us = static_cast<Timestamp>(std::llround(ms * 1000)); },
+         "With --visible-only and --frames-gt: a LSD line is seen where half or more of its pixels have an event in the "
+         "3 x 3 pixels around them within this of the frame's time (default 10)")
+      ->check(CLI::Range(0.1, 10000.0));
   app.add_option("--lsd-min-length", options.lsd.min_length_px, "With --frames-gt: LSD segments shorter than this (px) are dropped")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.0, 10000.0));

@@ -13,6 +13,7 @@ namespace evldt {
 namespace {
 
 const cv::Scalar kTruthColour(80, 220, 80), kSegmentColour(60, 60, 235), kWholeLineColour(235, 150, 40);  // BGR
+const cv::Scalar kUnseenTruthColour(200, 80, 220);  // LSD's lines without events along them (--visible-only)
 
 /// The rows of the step held at `t`: the latest step at or before it, if within `hold_us`.
 std::span<const SegmentRow> held_at(std::span<const SegmentRow> sorted, Timestamp t, Timestamp hold_us) {
@@ -41,10 +42,11 @@ void draw(cv::Mat& canvas, const Segment& s, int scale, const cv::Scalar& colour
 }  // namespace
 
 std::size_t write_overlays(const std::filesystem::path& dir, FrameReader& frames, const GroundTruthSteps& truth,
-                           const OverlayStream& segments, const OverlayStream& whole_lines, int scale) {
+                           const OverlayStream& segments, const OverlayStream& whole_lines, const VisibilitySplit* visibility,
+                           int scale) {
   std::filesystem::create_directories(dir);
   const std::vector<SegmentRow> segment_rows = by_time(segments.rows), whole_rows = by_time(whole_lines.rows);
-  std::vector<Segment> truth_segments;
+  std::vector<Segment> truth_segments, seen, unseen;
   std::vector<std::uint64_t> truth_ids;
   std::size_t written = 0, step = 0;
   cv::Mat grey, canvas;
@@ -56,10 +58,16 @@ std::size_t write_overlays(const std::filesystem::path& dir, FrameReader& frames
     cv::resize(frame->image, grey, {}, scale, scale, cv::INTER_NEAREST);
     cv::cvtColor(grey, canvas, cv::COLOR_GRAY2BGR);
     truth.segments_at(step, truth_segments, truth_ids);
+    if (visibility) {
+      (*visibility)(step, truth_segments, seen, unseen);
+      for (const Segment& s : unseen) draw(canvas, s, scale, kUnseenTruthColour, 2);
+      truth_segments = seen;
+    }
     for (const Segment& s : truth_segments) draw(canvas, s, scale, kTruthColour, 2);
     for (const SegmentRow& row : held_at(whole_rows, frame->t_us, whole_lines.hold_us)) draw(canvas, row.segment, scale, kWholeLineColour, 3);
     for (const SegmentRow& row : held_at(segment_rows, frame->t_us, segments.hold_us)) draw(canvas, row.segment, scale, kSegmentColour, 1);
-    const std::string caption = "t " + std::to_string(frame->t_us) + " us   LSD green, segments red, whole lines blue";
+    const std::string caption = "t " + std::to_string(frame->t_us) + " us   LSD green" + (visibility ? " (no events: purple)" : "") +
+                                ", segments red, whole lines blue";
     cv::putText(canvas, caption, {6, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
     cv::putText(canvas, caption, {6, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
     char name[32];

@@ -97,13 +97,15 @@ void StreamEvaluator::keep_edge_recall(std::optional<Timestamp> picture_at_us) {
   edge_recall_.emplace(matchers_.front().sensor(), picture_at_us);
 }
 
-void StreamEvaluator::score_visible_only(float min_normal_speed) {
-  if (!(min_normal_speed >= 0)) throw std::invalid_argument("the least speed across itself of a visible edge must not be negative");
+void StreamEvaluator::score_visible_only(VisibleOnly rule) {
+  if (!rule.split && !(rule.min_normal_speed >= 0)) {
+    throw std::invalid_argument("the least speed across itself of a visible edge must not be negative");
+  }
+  visible_rule_ = std::move(rule);
   std::vector<double> fractions(accuracy_.tolerance_fractions().begin(), accuracy_.tolerance_fractions().end());
   visible_accuracy_.emplace(fractions);
   visible_matcher_.emplace(matchers_.front().sensor());
   visible_counts_.resize(matchers_.size());
-  min_normal_speed_ = min_normal_speed;
 }
 
 void StreamEvaluator::score_steps_before(Timestamp until) {
@@ -130,9 +132,13 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
       edge_recall_->add_step(t, truth_, truth_ids_, predicted, matched_map_);
     }
     if (visible_accuracy_) {
-      normal_velocities_at(next_step_, 0.0f, speed_at_q0_);
-      normal_velocities_at(next_step_, 1.0f, speed_at_q1_);
-      split_by_normal_speed(truth_, speed_at_q0_, speed_at_q1_, min_normal_speed_, visible_truth_, hidden_truth_);
+      if (visible_rule_.split) {
+        visible_rule_.split(next_step_, truth_, visible_truth_, hidden_truth_);
+      } else {
+        normal_velocities_at(next_step_, 0.0f, speed_at_q0_);
+        normal_velocities_at(next_step_, 1.0f, speed_at_q1_);
+        split_by_normal_speed(truth_, speed_at_q0_, speed_at_q1_, visible_rule_.min_normal_speed, visible_truth_, hidden_truth_);
+      }
       visible_matcher_->match(predicted, visible_truth_, hidden_truth_, matchers_, visible_counts_);
       visible_accuracy_->add_step(visible_counts_, predicted.size(), visible_truth_.size());
       visible_pixels_ += visible_matcher_->visible_pixels();
@@ -251,11 +257,11 @@ Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_
 
 StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthSteps truth, SensorSize sensor,
                                       std::vector<double> tolerance_fractions, Timestamp output_period_us,
-                                      std::optional<float> visible_min_normal_speed) {
+                                      std::optional<VisibleOnly> visible_only) {
   std::stable_sort(rows.begin(), rows.end(), [](const SegmentRow& a, const SegmentRow& b) { return a.t_us < b.t_us; });
   const Timestamp hold_us = prediction_hold_us(rows, output_period_us, truth.times);
   StreamEvaluator evaluator(sensor, std::move(tolerance_fractions), std::move(truth), hold_us);
-  if (visible_min_normal_speed) evaluator.score_visible_only(*visible_min_normal_speed);
+  if (visible_only) evaluator.score_visible_only(std::move(*visible_only));
   std::vector<std::uint64_t> ids;
   std::vector<Segment> predicted;
   std::vector<float> velocities;

@@ -4,6 +4,8 @@
 // An imitation of the exact ground truth: LSD finds texture and shading edges too and splits lines
 // at weak stretches; its ids are per frame, so identity figures against it mean nothing.
 
+#include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -29,5 +31,22 @@ std::vector<Segment> lsd_segments(const cv::Mat& grey, const LsdParams& params);
 /// Every frame of `frames`, read at once, as a ground-truth step of its LSD segments. Throws
 /// FrameError (from the reader) for a frame that cannot be used, and when there is no frame.
 GroundTruthSteps frame_ground_truth_steps(FrameReader& frames, const LsdParams& params);
+
+/// What an events-only camera can see of a frame's LSD lines: those along which the recording's
+/// events fell around the frame's time. A still camera's static edges, and edges moving along
+/// themselves, give no events; LSD draws them all.
+struct EventSupportRule {
+  Timestamp half_window_us = 10'000;  ///< events within this of the frame's time count
+  /// The share of the line's samples (1 px apart, both ends included) with an event in the 3 x 3
+  /// pixels around them that makes the line seen.
+  float min_share = 0.5f;
+};
+
+/// For every step of `truth`, a flag per piece (in segments_at's order): 1 where the events that
+/// `read` hands over (batches in time order, as EventSource::read: false at the end) hold `rule`.
+/// Reads the events once, keeping the latest time of each pixel.
+std::vector<std::vector<std::uint8_t>> event_supported_pieces(const GroundTruthSteps& truth, SensorSize sensor,
+                                                              const EventSupportRule& rule,
+                                                              const std::function<bool(EventBatch&)>& read);
 
 }  // namespace evldt

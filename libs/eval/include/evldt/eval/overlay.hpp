@@ -20,11 +20,12 @@ struct OverlayStream {
 };
 
 /// Writes `dir`/step_NNNNN.png for every ground-truth step of `truth` (frame_ground_truth_steps of
-/// the same frames): the frame in grey, LSD's lines in green, `segments` in red and `whole_lines`
-/// in blue, each the step held at the frame's time (none past its hold), drawn `scale` times the
-/// sensor's size. Returns the number of pictures; throws std::runtime_error when one cannot be
-/// written, FrameError as the frames do.
+/// the same frames): the frame in grey, LSD's lines in green (with `visibility`, those it hides in
+/// purple), `segments` in red and `whole_lines` in blue, each the step held at the frame's time
+/// (none past its hold), drawn `scale` times the sensor's size. Returns the number of pictures;
+/// throws std::runtime_error when one cannot be written, FrameError as the frames do.
 std::size_t write_overlays(const std::filesystem::path& dir, FrameReader& frames, const GroundTruthSteps& truth,
-                           const OverlayStream& segments, const OverlayStream& whole_lines, int scale = 3);
+                           const OverlayStream& segments, const OverlayStream& whole_lines,
+                           const VisibilitySplit* visibility = nullptr, int scale = 3);
 
 }  // namespace evldt

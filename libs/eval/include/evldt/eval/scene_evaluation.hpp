@@ -40,6 +40,18 @@ GroundTruthSteps csv_ground_truth_steps(const std::vector<GroundTruthRow>& rows)
 /// indices are the kept steps').
 GroundTruthSteps steps_within(GroundTruthSteps truth, Timestamp first, Timestamp last);
 
+/// Splits the true pieces of step `index` into what an events-only camera can see and what it
+/// cannot (visible_score.hpp).
+using VisibilitySplit = std::function<void(std::size_t index, std::span<const Segment> truth, std::vector<Segment>& visible,
+                                           std::vector<Segment>& hidden)>;
+
+/// Scoring also against what an events-only camera can see: by the true edges' speed across
+/// themselves (simulated ground truth), or by a split of its own (LSD's lines with event support).
+struct VisibleOnly {
+  float min_normal_speed = 2.0f;  ///< px/s
+  VisibilitySplit split;          ///< used instead of the speed where set
+};
+
 /// How a prediction stream lined up with the ground-truth steps.
 struct StepCoverage {
   std::uint64_t ground_truth_steps = 0;
@@ -97,12 +109,17 @@ class StreamEvaluator {
   void keep_edge_recall(std::optional<Timestamp> picture_at_us = std::nullopt);
   /// The recall per edge, when kept.
   [[nodiscard]] const std::optional<EdgeRecall>& edge_recall() const { return edge_recall_; }
-  /// Also score against only what an events-only camera can see (visible_score.hpp): the true edges
-  /// where they move across themselves at `min_normal_speed` px/s or more, the speed from the lines'
-  /// places at the neighbouring steps (before any step; throws std::invalid_argument if negative).
-  void score_visible_only(float min_normal_speed);
+  /// Also score against only what an events-only camera can see (visible_score.hpp), before any
+  /// step: by the rule's split, or else the true edges where they move across themselves at
+  /// min_normal_speed px/s or more, the speed from the lines' places at the neighbouring steps
+  /// (throws std::invalid_argument if negative).
+  void score_visible_only(VisibleOnly rule);
   /// That score, when asked for.
   [[nodiscard]] const std::optional<EvaluationAccumulator>& visible_accuracy() const { return visible_accuracy_; }
+  /// The split it was given (VisibleOnly::split), or nullptr.
+  [[nodiscard]] const VisibilitySplit* visibility_split() const {
+    return visible_accuracy_ && visible_rule_.split ? &visible_rule_.split : nullptr;
+  }
   /// Of the true pixels over all steps, those moving fast enough to be seen and those not (with
   /// score_visible_only).
   [[nodiscard]] std::uint64_t visible_truth_pixels() const { return visible_pixels_; }
@@ -123,7 +140,7 @@ class StreamEvaluator {
   EvaluationAccumulator accuracy_;
   std::optional<EvaluationAccumulator> visible_accuracy_;
   std::optional<VisibleOnlyMatcher> visible_matcher_;
-  float min_normal_speed_ = 0;
+  VisibleOnly visible_rule_;
   std::vector<float> speed_at_q0_, speed_at_q1_;
   std::vector<Segment> visible_truth_, hidden_truth_;
   std::vector<MatchCounts> visible_counts_;
@@ -162,11 +179,11 @@ Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_
 /// Scores predicted segment rows (of a CSV, a log or Python; any order, sorted by time here) on
 /// ground-truth steps with StreamEvaluator's rule and a hold of kHoldPeriods output periods.
 /// output_period_us 0: the median spacing of the predicted steps (of the ground truth's, with fewer
-/// than two). With visible_min_normal_speed, also scores what an events-only camera can see
+/// than two). With `visible_only`, also scores what an events-only camera can see
 /// (StreamEvaluator::score_visible_only).
 StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthSteps truth, SensorSize sensor,
                                       std::vector<double> tolerance_fractions, Timestamp output_period_us,
-                                      std::optional<float> visible_min_normal_speed = std::nullopt);
+                                      std::optional<VisibleOnly> visible_only = std::nullopt);
 
 /// The nominal output period of a prediction: the median spacing of its distinct step times, or 0
 /// with fewer than two.
