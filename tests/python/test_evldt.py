@@ -24,6 +24,7 @@ BUILD = pathlib.Path(os.environ.get("EVLDT_BUILD", "build/dev"))
 SIM = BUILD / "tools/evldt-sim/evldt-sim"
 OFFLINE = BUILD / "tools/evldt-offline/evldt-offline"
 EVAL = BUILD / "tools/evldt-eval/evldt-eval"
+AEDAT4_FIXTURE = BUILD / "tests/aedat4_fixture"
 REAL = pathlib.Path(__file__).resolve().parents[2] / ".." / "shared" / "real"
 
 
@@ -61,6 +62,22 @@ def test_readers_give_the_simulated_events_in_every_format(boxes):
         for field in ("t", "x", "y"):
             np.testing.assert_array_equal(got.events[field], simulated.events[field], err_msg=fmt)
         np.testing.assert_array_equal(got.events["p"] > 0, simulated.events["p"] > 0, err_msg=fmt)
+
+
+@pytest.mark.parametrize("compression", ["none", "lz4", "zstd"])
+def test_the_aedat_librarys_layout_reads_as_dvs(tmp_path, compression):
+    # The same scene with each FlatBuffer finished size-prefixed (DV) or plain with its size put in
+    # front (the aedat library): the same events and frames.
+    for layout in ("dv", "aedat-library"):
+        run(AEDAT4_FIXTURE, tmp_path / f"{layout}.aedat4", layout, compression)
+    dv, library = (evldt.read(tmp_path / f"{layout}.aedat4") for layout in ("dv", "aedat-library"))
+    assert len(dv.events) > 10_000 and (library.width, library.height) == (dv.width, dv.height) == (240, 180)
+    np.testing.assert_array_equal(library.events, dv.events)
+    dv_frames, library_frames = (evldt.read_frames(tmp_path / f"{layout}.aedat4", 240, 180) for layout in ("dv", "aedat-library"))
+    assert len(dv_frames) == len(library_frames) == 14
+    for (t_dv, image_dv), (t_library, image_library) in zip(dv_frames, library_frames):
+        assert t_dv == t_library
+        np.testing.assert_array_equal(image_library, image_dv)
 
 
 def test_chunks_join_to_the_whole_recording(boxes):
