@@ -284,6 +284,7 @@ if [[ -f $real ]]; then
     grep -q "3 ground-truth steps scored" "$work/real_$run.err" || fail "3 frames of $real scored: $(cat "$work/real_$run.err")"
     awk -v run="real_$run.csv" '$1 == run && $2 == "-" { found = 1; if (!($5 > 0.1)) exit 1 } END { exit !found }' "$work/real_$run.txt" ||
       fail "F@1% of the $run on $real: $(cat "$work/real_$run.txt")"
+    grep -qiw nan "$work/real_$run.txt" && fail "a nan in evldt-eval's tables on $real: $(cat "$work/real_$run.txt")"
     # Its first frame comes before any output: that second's precision is n/a, never nan.
     grep -Eq "^real_$run.csv +t0 1633953690 s: +0-1 s n/a / 0\.000 +1-2 s 0\.[0-9]{3} / 0\.[0-9]{3}$" "$work/real_$run.txt" ||
       fail "per second on $real: $(cat "$work/real_$run.txt")"
