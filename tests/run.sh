@@ -4,7 +4,9 @@
 #   2. the whole suite again built with AddressSanitizer + UndefinedBehaviorSanitizer;
 #   3. the whole suite again built with ThreadSanitizer;
 #   4. each libFuzzer target for a few seconds from its corpus (clang).
-# Usage: tests/run.sh [--quick]   (--quick: step 1 only)
+# Usage: tests/run.sh [--quick|--unit]
+#   --quick: step 1 only; --unit: the Release build and its GoogleTest cases and corpus replays only
+#   (ctest -L unit: about 30 s once built; the loop to run while changing code, CONTRIBUTING.md)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -15,13 +17,22 @@ deploy/install-deps.sh clang libclang-rt-14-dev iproute2 chromium nodejs ccache
 source tests/suites.sh
 started=$SECONDS
 
+mode=${1:-}
+case $mode in
+  "" | --quick | --unit) ;;
+  *) echo "usage: tests/run.sh [--quick|--unit]" >&2; exit 1 ;;
+esac
 for suite in "${suites[@]}"; do
   echo "=== $suite build and tests ($((SECONDS - started)) s so far)"
   build_suite "$suite"
+  if [[ $mode == --unit ]]; then
+    test_suite "$suite" -L unit
+    break
+  fi
   test_suite "$suite"
-  if [[ "${1:-}" == "--quick" ]]; then break; fi
+  if [[ $mode == --quick ]]; then break; fi
 done
-if [[ "${1:-}" != "--quick" ]]; then
+if [[ -z $mode ]]; then
   echo "=== fuzz smoke run ($((SECONDS - started)) s so far)"
   tests/fuzz/run-fuzzers.sh 5
 fi

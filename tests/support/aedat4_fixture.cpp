@@ -11,6 +11,7 @@
 #include <zstd.h>
 
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -32,9 +33,10 @@ void append_le32(Bytes& out, std::uint32_t value) {
 }
 
 Bytes finished(flatbuffers::FlatBufferBuilder& builder, bool aedat_library) {
-  Bytes bytes;
-  if (aedat_library) append_le32(bytes, static_cast<std::uint32_t>(builder.GetSize()));
-  bytes.insert(bytes.end(), builder.GetBufferPointer(), builder.GetBufferPointer() + builder.GetSize());
+  const std::size_t prefix = aedat_library ? 4 : 0;
+  Bytes bytes(prefix + builder.GetSize());
+  for (std::size_t k = 0; k < prefix; ++k) bytes[k] = static_cast<std::uint8_t>(builder.GetSize() >> (8 * k));
+  std::memcpy(bytes.data() + prefix, builder.GetBufferPointer(), builder.GetSize());
   return bytes;
 }
 

@@ -20,7 +20,7 @@ void SegmentCsvWriter::write_step(Timestamp t, std::span<const TrackedLine> line
   for (const TrackedLine* line : sorted_) {
     const Segment& s = line->segment;
     char* at = row;
-    char* const end = row + sizeof row;
+    char* const end = row + sizeof row - 1;  // a field leaves room for the separator after it
     const auto put = [&](auto value, auto... format) {
       at = std::to_chars(at, end, value, format...).ptr;
       *at++ = ',';
