@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The consumer SDK (issue 51): evldt installed to a prefix; examples/consumer, a separate CMake
+# The consumer SDK: evldt installed to a prefix; examples/consumer, a separate CMake
 # project, configured with find_package(evldt) against it and built; the same program built with
 # pkg-config's flags; both run against a live camera -> lines system on loopback and must print the
 # segments and whole lines they receive.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The Debian package (issue 51): made by cpack from the Release build (configured with the prefix
+# The Debian package: made by cpack from the Release build (configured with the prefix
 # /usr), named and filled as a robot's image expects, its dependencies declared (and installable
 # here), then unpacked into a temporary root from which camera -> lines -> viz run on loopback:
 # nothing of the build tree is needed. Skipped (77) for builds of another prefix (the sanitizer ones).

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# evldt-export (issue 29): a live run recorded by lcm-logger (with undecodable messages on the
+# evldt-export: a live run recorded by lcm-logger (with undecodable messages on the
 # camera's channels) written as MCAP in Foxglove's schemas, read back with evldt's own MCAP reader
 # (mcap_channel_dump) and validated against Foxglove's published JSON schemas (npm @foxglove/schemas,
 # with ajv; pinned in tests/export/package-lock.json, installed into the build folder once; skips,

@@ -1,4 +1,4 @@
-// Intensity frames (issue 28): the ECD layout written and read back, sensor_msgs/Image in ROS 1
+// Intensity frames: the ECD layout written and read back, sensor_msgs/Image in ROS 1
 // bags written with rosbag_storage and in ROS 2 bags (CDR in SQLite) written from the message's
 // description, MVSEC's HDF5 frames written with the HDF5 library, AEDAT 3.1 frame packets, jAER's
 // AEDAT 2.0 DAVIS APS samples and AEDAT 4.0 frame streams written from the format descriptions, their

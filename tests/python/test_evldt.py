@@ -212,7 +212,7 @@ def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
     for mine, expected in zip(visible["accuracy"], theirs["accuracy"]):
         for key in ("tolerance", "precision", "recall", "f"):
             assert mine[key] == pytest.approx(expected[key], abs=1e-12), key
-    # The same run on a clock of Unix-epoch microseconds, as DV writes them (issue 49): the same figures.
+    # The same run on a clock of Unix-epoch microseconds, as DV writes them: the same figures.
     epoch = 1_600_000_000_000_000
     segments["t"] += epoch
     truth["t"] += epoch
@@ -368,7 +368,7 @@ def test_read_frames_gives_the_images_of_an_ecd_folder_and_names_a_bad_one(tmp_p
         evldt.read_frames(tmp_path, 64, 48)
 
 
-# --- live lines, received without the lcm Python module (issue 51) -----------------------------------
+# --- live lines, received without the lcm Python module -----------------------------------
 LINES = BUILD / "services/evldt-lines/evldt-lines"
 CAMERA = BUILD / "services/evldt-camera/evldt-camera"
 EXAMPLE = pathlib.Path(__file__).resolve().parents[2] / "libs/python/examples/subscribe_lines.py"

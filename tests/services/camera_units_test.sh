@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The systemd units (issue 51): evldt-lines@, evldt-viz@ and evldt-logger pass `systemd-analyze
+# The systemd units: evldt-lines@, evldt-viz@ and evldt-logger pass `systemd-analyze
 # verify`, and so do evldt-camera@ instances for live cameras: each example source of deploy/systemd/examples
 # (a RAW stream over TCP, a followed RAW file, DV's AEDAT 4.0 and cAER's AEDAT 3.1 network output)
 # as /etc/evldt/camera-NAME.env: the instance unit passes `systemd-analyze verify`, and its command

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Live inputs end to end (issue 26), real processes over UDP multicast on loopback (ttl=0): a RAW
+# Live inputs end to end, real processes over UDP multicast on loopback (ttl=0): a RAW
 # recording fed to evldt-camera in real time in pieces that split its words, as a driver or
 # recorder would (pieces of random size are the unit tests' part: tests/sources), through each live path (standard input, a TCP stream, a file followed while it is
 # written, libcaer's AEDAT 3.1 network stream, and DV's AEDAT 4.0 network output of a real DVXplorer recording with a server restart

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The systemd units as installed: every LCM URL a unit's command line gets (its --lcm-url, or
 # LCM_DEFAULT_URL from its EnvironmentFile) is a multicast URL with the 8 MiB receive buffer, so
-# that no receiver (lcm-logger above all) records with the lossy default (issue 51).
+# that no receiver (lcm-logger above all) records with the lossy default.
 # Usage: units_test.sh SOURCE_DIR
 set -uo pipefail
 units=$1/deploy/systemd

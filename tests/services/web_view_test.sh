@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The viz's live web view (issue 29) in a real browser: evldt-camera (a simulated scene, looped) ->
+# The viz's live web view in a real browser: evldt-camera (a simulated scene, looped) ->
 # evldt-lines -> evldt-viz --headless --http over UDP multicast on loopback. Headless Chromium opens
 # the page twice at once (a screenshot, and the page's DOM after its scripts ran) while a third
 # client stalls on pictures it never reads; the page's buttons' requests toggle a layer; the viz

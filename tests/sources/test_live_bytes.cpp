@@ -1,4 +1,4 @@
-// Live inputs (issue 26): a recording followed while it is written, standard input's kind of pipe,
+// Live inputs: a recording followed while it is written, standard input's kind of pipe,
 // and a TCP stream, each read in pieces of random size; the events must be exactly those of the
 // finished file, waiting must cost no CPU, and a cut or a replaced file must say so.
 

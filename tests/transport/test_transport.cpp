@@ -1082,7 +1082,7 @@ TEST(PayloadQueue, AFullQueueHoldsTheProducerUntilASlotFreesOrItStops) {
 namespace evldt {
 namespace {
 
-// ---- lcm-logs read with every damage said (issue 51) ----------------------------------------------
+// ---- lcm-logs read with every damage said ----------------------------------------------
 
 /// A log of `count` records written by LCM's own LogFile, record k on channel "CH_k%3" with k + 40
 /// bytes of k; returns where each record starts.

@@ -99,7 +99,7 @@ Scene monitor_hd() {
   return s;
 }
 
-// The scenes of real sensors' troubles (issue 14), 5 s each: boxes-6dof's motion goes on.
+// The scenes of real sensors' troubles, 5 s each: boxes-6dof's motion goes on.
 
 // boxes-6dof seen by a noisy sensor (its camera model: scene_camera_model).
 Scene noisy_boxes() {
@@ -146,7 +146,7 @@ Scene night_boxes() {
   return s;
 }
 
-// Ten-second scenes for tracks that last (issue 15), like the seed paper's 10 s sequences.
+// Ten-second scenes for tracks that last, like the seed paper's 10 s sequences.
 
 // boxes-6dof's boxes under a 10 s camera motion of other frequencies and phases.
 Scene boxes_10s() {
@@ -249,7 +249,7 @@ const std::vector<std::string>& scene_names() {
 
 SimulatorConfig scene_camera_model(std::string_view name) {
   SimulatorConfig model;
-  if (name == "noisy-boxes") {  // the noisy variant of issue 14's measurement
+  if (name == "noisy-boxes") {  // the noise of real sensors
     model.noise_rate_hz = 2;
     model.hot_pixels = 40;
     model.contrast_sigma = 0.08;

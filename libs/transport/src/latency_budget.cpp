@@ -28,7 +28,7 @@ int LatencyBudget::stride(std::int64_t publish_utime, std::int64_t now_utime) {
   if (last_queueing_us_ <= budget_us_) return 1;
   if (policy_ == OverloadPolicy::Shed || last_queueing_us_ > 2 * budget_us_) return 0;
   // Thinned from the budget on, not below it: thinning earlier (from a quarter or half of it) stretched
-  // the rounds and thinned batches storage would have caught up with (docs/realtime.md, issue 48).
+  // the rounds and thinned batches storage would have caught up with (docs/realtime.md).
   return last_queueing_us_ <= budget_us_ * 3 / 2 ? 2 : 4;
 }
 

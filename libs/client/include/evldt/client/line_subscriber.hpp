@@ -1,5 +1,5 @@
 #pragma once
-// evldt's consumer SDK (issue 51): a program of one's own receives a camera's segments and whole lines
+// evldt's consumer SDK: a program of one's own receives a camera's segments and whole lines
 // from a running evldt-lines as plain structs, with nothing of evldt but the message types. Header
 // only; installed with the message types (find_package(evldt): evldt::client; pkg-config: evldt).
 //

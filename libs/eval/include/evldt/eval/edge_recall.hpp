@@ -1,5 +1,5 @@
 #pragma once
-// Recall per ground-truth edge (issue 52): which true edges a method misses, against what makes an
+// Recall per ground-truth edge: which true edges a method misses, against what makes an
 // edge hard to see - its image speed across itself (an event camera sees an edge only as it moves
 // across itself), its length, and how close the nearest parallel edge lies (two edges in one block).
 

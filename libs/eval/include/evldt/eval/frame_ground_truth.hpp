@@ -1,5 +1,5 @@
 #pragma once
-// Ground truth from intensity frames, as the paper makes it (issue 28): LSD (OpenCV's
+// Ground truth from intensity frames, as the paper makes it: LSD (OpenCV's
 // createLineSegmentDetector, von Gioi et al.) on each frame gives the true lines at the frame's time.
 // An imitation of the exact ground truth: LSD finds texture and shading edges too and splits lines
 // at weak stretches; its ids are per frame, so identity figures against it mean nothing.

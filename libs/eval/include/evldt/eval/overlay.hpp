@@ -1,5 +1,5 @@
 #pragma once
-// Pictures of a run scored against frames (issue 49): for each ground-truth step, its frame with
+// Pictures of a run scored against frames: for each ground-truth step, its frame with
 // LSD's lines (the ground truth) and the lines evldt held at that time, segments and whole lines in
 // colours of their own, so a person can see where they agree.
 

@@ -1,5 +1,5 @@
 #pragma once
-// How much of the whole lines the block segments of the same step back (issue 27). A whole line
+// How much of the whole lines the block segments of the same step back. A whole line
 // joins segments and may bridge the gaps between them and reach on to a corner; its length within
 // a small distance of some segment of its step is what the lattice's events support directly.
 // A line that bridges the gap between two separate edges, or cuts across a pattern to a corner,

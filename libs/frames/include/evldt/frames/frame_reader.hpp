@@ -1,6 +1,6 @@
 #pragma once
 // Intensity frames a recording holds beside its events (a DAVIS's APS frames, a simulator's
-// renderings), pixel-aligned with the events: the ground truth the paper draws lines from (issue 28).
+// renderings), pixel-aligned with the events: the ground truth the paper draws lines from.
 // A reader per container, behind one interface, as the event readers are: the Event Camera
 // Dataset's folder layout; sensor_msgs/Image in ROS 1 and 2 bags (.db3, MCAP), MVSEC's HDF5 and AEDAT
 // frames, whose containers (libs/containers) yield images that are converted here by their pixel

@@ -1,5 +1,5 @@
 #pragma once
-// Whether a block's line is a piece of a curve (issue 27, curves): the events beyond its ends.
+// Whether a block's line is a piece of a curve: the events beyond its ends.
 //
 // A block holds too short a stretch of an edge to tell an arc from a line: a circle of radius 5 b
 // is 0.03 b off the chord across one block, well inside the inlier band, so arcs are detected and

@@ -72,9 +72,9 @@ struct ScheduleParams {
 };
 
 /// Joining block segments into whole lines (whole_lines.hpp). Chosen on boxes-10s: tighter joins
-/// (8 degrees, 0.3 b, 1 b) split true lines and halved IDF1 (0.115 against 0.315). The angle was
-/// 12 degrees until issue 27: the block segments along an edge that moves across itself tilt by up to
-/// 15-20 degrees either way (a fit across its band of events), and joined none of them.
+/// (8 degrees, 0.3 b, 1 b) split true lines and halved IDF1 (0.115 against 0.315). The angle is wide
+/// because the block segments along an edge that moves across itself tilt by up to 15-20 degrees
+/// either way (a fit across its band of events): at 12 degrees none of them joined.
 struct WholeLineParams {
   float max_angle_deg = 20.0f;     ///< a segment joins a line whose direction is this close to its own
   float max_offset_ratio = 0.6f;   ///< of b: both its ends within this of the line

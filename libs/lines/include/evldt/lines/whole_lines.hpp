@@ -1,6 +1,6 @@
 #pragma once
 // Whole lines: block segments that lie along one straight edge, joined into a line that is tracked
-// as one object over time, with its own id (issues 15 and 16). Runs on a snapshot of the live
+// as one object over time, with its own id. Runs on a snapshot of the live
 // segments at each output step, after tracking; deterministic for a given sequence of calls.
 
 #include <array>

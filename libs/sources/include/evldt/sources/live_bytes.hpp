@@ -1,5 +1,5 @@
 #pragma once
-// Bytes from a camera while it records (issue 26): a file its recorder is still writing, standard
+// Bytes from a camera while it records: a file its recorder is still writing, standard
 // input (`any_driver | evldt-camera -`) and a TCP stream. Each waits for bytes without using the CPU
 // (poll, inotify) and gives up waiting when `stop` is set (checked every 100 ms), which ends the
 // stream as its end of file would.

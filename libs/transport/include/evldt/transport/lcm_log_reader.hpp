@@ -1,7 +1,7 @@
 #pragma once
 // An lcm-logger file, read record by record, with every damage counted and said. LCM's own LogFile
 // skips bytes it cannot read and takes a cut last record for the end without a word, so a log with
-// a damaged stretch read as a whole one (issue 51). The format (LCM's event log): each record is a
+// a damaged stretch read as a whole one. The format (LCM's event log): each record is a
 // big-endian header - sync word 0xEDA1DA01, event number (int64), time (int64, us), channel length
 // (int32), data length (int32) - then the channel name and the data.
 

@@ -1,5 +1,5 @@
 #pragma once
-// How far a live camera's batches are behind its sensor (issue 26): the sensor's clock (event time)
+// How far a live camera's batches are behind its sensor: the sensor's clock (event time)
 // against the wall clock when a batch is published. The two clocks' offset is the least difference
 // seen lately (judged as LatencyBudget judges queueing: over one to two windows of 2 s, so a drift
 // or a step is forgotten); a batch's lag is its own difference less that offset: the time its
