@@ -371,7 +371,7 @@ TEST(StreamEvaluator, VisibleOnlyLeavesOutAnEdgeMovingAlongItselfAndWhatIsPredic
   for (const bool off_edge : {false, true}) {
     SCOPED_TRACE(off_edge);
     StreamEvaluator evaluator(kSensor, {0.01}, truth, std::llround(StreamEvaluator::kHoldPeriods * kGtPeriod));
-    evaluator.score_visible_only({.min_normal_speed = 2.0f});
+    evaluator.score_visible_only(VisibleOnly::by_speed(2.0f));
     for (int k = 0; k < kGtSteps; ++k) {
       const auto index = static_cast<std::size_t>(k);
       predict(evaluator, k * kGtPeriod, 1, {moving_line(index), off_edge ? row_segment(70, 10, 50) : along_itself(index)});
@@ -391,7 +391,7 @@ TEST(StreamEvaluator, VisibleOnlyLeavesOutAnEdgeMovingAlongItselfAndWhatIsPredic
     }
   }
   StreamEvaluator evaluator = moving_evaluator();
-  EXPECT_THROW(evaluator.score_visible_only({.min_normal_speed = -1.0f}), std::invalid_argument);
+  EXPECT_THROW(evaluator.score_visible_only(VisibleOnly::by_speed(-1.0f)), std::invalid_argument);
 }
 
 // The paper's view: counts summed up to each second. Steps at 0, 0.5, 1.5, 2 and 2.5 s, the same

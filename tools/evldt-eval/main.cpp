@@ -62,7 +62,7 @@ std::filesystem::path events_of_frames(const Options& options) {
 // speed; LSD's lines of frames by the recording's events along them (read once, here).
 std::optional<VisibleOnly> visible_rule(const Options& options, const GroundTruthSteps& truth, SensorSize sensor) {
   if (!options.visible_only) return std::nullopt;
-  if (options.frames_gt.empty()) return VisibleOnly{.min_normal_speed = options.min_normal_speed};
+  if (options.frames_gt.empty()) return VisibleOnly::by_speed(options.min_normal_speed);
   const std::filesystem::path path = events_of_frames(options);
   const auto source = open_recording(path, std::nullopt, "", std::numeric_limits<Timestamp>::max() / 4);
   auto supported = std::make_shared<std::vector<std::vector<std::uint8_t>>>(
@@ -74,13 +74,13 @@ std::optional<VisibleOnly> visible_rule(const Options& options, const GroundTrut
   }
   spdlog::info("{} of {} LSD lines have events of {} along them (half or more of their pixels within +-{:.1f} ms)", seen,
                lines, path.string(), static_cast<double>(options.support.half_window_us) * 1e-3);
-  return VisibleOnly{.split = [supported](std::size_t index, std::span<const Segment> pieces, std::vector<Segment>& visible,
+  return VisibleOnly::by_split([supported](std::size_t index, std::span<const Segment> pieces, std::vector<Segment>& visible,
                                           std::vector<Segment>& hidden) {
     visible.clear();
     hidden.clear();
     const std::vector<std::uint8_t>& flags = (*supported)[index];
     for (std::size_t k = 0; k < pieces.size(); ++k) (k < flags.size() && flags[k] ? visible : hidden).push_back(pieces[k]);
-  }};
+  });
 }
 
 struct Report {
@@ -544,8 +544,8 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
         whole.keep_edge_recall(middle);
       }
       if (options.visible_only) {
-        last->score_visible_only({.min_normal_speed = options.min_normal_speed});
-        whole.score_visible_only({.min_normal_speed = options.min_normal_speed});
+        last->score_visible_only(VisibleOnly::by_speed(options.min_normal_speed));
+        whole.score_visible_only(VisibleOnly::by_speed(options.min_normal_speed));
       }
       const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole, options.thin);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -307,7 +307,7 @@ py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<
     GroundTruthSteps steps = csv_ground_truth_steps(truth_rows);
     evaluator.emplace(evaluate_segment_rows(std::move(rows), std::move(steps), SensorSize{width, height}, tolerances,
                                             output_period_us,
-                                            min_normal_speed ? std::optional<VisibleOnly>(VisibleOnly{.min_normal_speed = *min_normal_speed})
+                                            min_normal_speed ? std::optional<VisibleOnly>(VisibleOnly::by_speed(*min_normal_speed))
                                                              : std::nullopt));
   }
   py::dict out;

@@ -7,6 +7,7 @@
 #include <functional>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "evldt/eval/accumulator.hpp"
@@ -50,6 +51,8 @@ using VisibilitySplit = std::function<void(std::size_t index, std::span<const Se
 struct VisibleOnly {
   float min_normal_speed = 2.0f;  ///< px/s
   VisibilitySplit split;          ///< used instead of the speed where set
+  [[nodiscard]] static VisibleOnly by_speed(float min_normal_speed) { return {min_normal_speed, {}}; }
+  [[nodiscard]] static VisibleOnly by_split(VisibilitySplit split) { return {0.0f, std::move(split)}; }
 };
 
 /// How a prediction stream lined up with the ground-truth steps.
