@@ -17,6 +17,7 @@
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/eval/whole_line_support.hpp"
 #include "evldt/sim/scenes.hpp"
+#include "eval/reference_matching.hpp"
 
 namespace evldt {
 namespace {

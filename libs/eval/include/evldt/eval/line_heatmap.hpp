@@ -65,7 +65,7 @@ struct Prf {
 /// distance (of pixel centres) is <= diagonal_tolerance_px: Hopcroft-Karp on the pixel graph. The
 /// BSDS benchmark solves a min-cost assignment with a high outlier cost instead; that gives the same
 /// count unless giving up one pair shortens the others by two outlier costs in all, which takes some
-/// 200 pairs (see min_cost_matched_count_reference). Scratch buffers live in the object and are
+/// 200 pairs (tests/eval/reference_matching.hpp). Scratch buffers live in the object and are
 /// reused: a warmed-up matcher allocates only when a call needs more room than any call before it.
 /// The result is deterministic (pixels and neighbours are visited in a fixed order).
 class HeatmapMatcher {
@@ -134,18 +134,5 @@ class HeatmapMatcher {
   std::uint32_t free_layer_ = 0;  ///< layer at which the current phase reaches free ground-truth pixels
   std::uint64_t matched_ = 0;
 };
-
-/// Most pixels per side that min_cost_matched_count_reference accepts (its cost is cubic).
-inline constexpr std::size_t kReferenceMaxPixels = 600;
-
-/// Test reference, for small scenes only: rasterises like HeatmapMatcher and solves the BSDS-style
-/// assignment, where a pair within tolerance costs its distance, an unmatched pixel costs
-/// outlier_cost_factor * tolerance and pairs beyond tolerance are not allowed, exactly with the
-/// Hungarian algorithm; returns the number of pairs. Throws std::length_error above
-/// kReferenceMaxPixels pixels per side.
-[[nodiscard]] std::uint64_t min_cost_matched_count_reference(SensorSize sensor, double tolerance_fraction,
-                                                             std::span<const Segment> predicted,
-                                                             std::span<const Segment> ground_truth,
-                                                             double outlier_cost_factor = 100.0);
 
 }  // namespace evldt
