@@ -37,13 +37,22 @@ int main(int argc, char** argv) {
       return 1;
     }
     const PipelineConfig config = options.resolve(*sensor);
-    std::printf("# evldt pipeline configuration for a %dx%d sensor (evldt-config)\n", sensor->width, sensor->height);
+    // config/<size>.toml are this output at the defaults (a test compares every size).
+    std::printf("# evldt's pipeline for a %dx%d sensor, written by evldt-config (docs/configuration.md).\n"
+                "# Keys are the long command-line flags; a flag given on the command line overrides the file.\n",
+                sensor->width, sensor->height);
     for (const Parameter& parameter : pipeline_parameters()) {
       std::string value = parameter.value_in(config);
       if (parameter.flag == "width") value = std::to_string(sensor->width);
       if (parameter.flag == "height") value = std::to_string(sensor->height);
       if (parameter.flag == "time-slack-us") value = std::to_string(options.time_slack_us());
-      std::printf("%s = %s\n", std::string(parameter.flag).c_str(), toml_value(parameter, value).c_str());
+      const std::string flag(parameter.flag);
+      if (parameter.flag == "threads" && !options.given(flag)) {
+        // This machine's default would pin another machine's: left unset.
+        std::printf("# %s: unset, %s\n", flag.c_str(), std::string(parameter.default_text).c_str());
+        continue;
+      }
+      std::printf("%s = %s\n", flag.c_str(), toml_value(parameter, value).c_str());
     }
     return 0;
   });

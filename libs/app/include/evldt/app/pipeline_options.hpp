@@ -26,11 +26,10 @@ class PipelineOptions {
   [[nodiscard]] PipelineConfig resolve(SensorSize sensor) const;
   /// --time-slack-us, 1000 unless given.
   [[nodiscard]] Timestamp time_slack_us() const;
-
- private:
   /// The text given for a parameter of pipeline_parameters(), by flag; nullopt if unset.
   [[nodiscard]] const std::optional<std::string>& given(std::string_view flag) const;
 
+ private:
   std::vector<std::optional<std::string>> values_;  ///< one per pipeline_parameters() entry
 };
 
