@@ -11,7 +11,7 @@ export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 ignore_noninstrumen
 
 suite_cmake_args() {  # suite_cmake_args NAME
   case $1 in
-    release) echo -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr ;;  # the prefix of the Debian package it makes
+    release) echo -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr -DEVLDT_WERROR=ON ;;  # the prefix of the Debian package it makes; warnings fail
     asan) echo -DEVLDT_SANITIZE=address ;;
     tsan) echo -DEVLDT_SANITIZE=thread ;;
     *) echo "unknown suite $1" >&2; return 1 ;;

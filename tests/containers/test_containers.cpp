@@ -393,7 +393,7 @@ void put_header(std::vector<std::uint8_t>& out, const std::string& frame_id) {
 
 /// A dvs_msgs/EventArray as ROS 1 serializes it.
 RawRosMessage dvs_event_array(const EventBatch& events, std::size_t from, std::size_t to) {
-  RawRosMessage message{std::string(kRos1EventArrayType), {}};
+  RawRosMessage message{std::string(kRos1EventArrayType), {}, {}};
   put_header(message.bytes, "dvs");
   put32(message.bytes, 180);  // height
   put32(message.bytes, 240);  // width
@@ -423,7 +423,7 @@ TEST(Rosbag1, DvsEventArraysInEveryChunkCompressionAndEventPackets) {
       bag.setChunkThreshold(4096);  // many chunks
       for (std::size_t at = 0; at < events.size(); at += 250) {
         const ros::Time stamp(static_cast<double>(events.t[at]) * 1e-6);
-        bag.write("/imu", stamp, RawRosMessage{"sensor_msgs/Imu", std::vector<std::uint8_t>(20, 1)});
+        bag.write("/imu", stamp, RawRosMessage{"sensor_msgs/Imu", std::vector<std::uint8_t>(20, 1), {}});
         bag.write("/dvs/events", stamp, dvs_event_array(events, at, std::min(events.size(), at + 250)));
       }
     }
@@ -446,7 +446,7 @@ TEST(Rosbag1, DvsEventArraysInEveryChunkCompressionAndEventPackets) {
   detail::make_evt3_encoder({640, 480})->encode(sweep, words);
   {
     rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
-    RawRosMessage packet{std::string(kRos1EventPacketType), {}};
+    RawRosMessage packet{std::string(kRos1EventPacketType), {}, {}};
     put_header(packet.bytes, "prophesee");
     put32(packet.bytes, 480);
     put32(packet.bytes, 640);
