@@ -160,6 +160,11 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
   EXPECT_EQ(totals.events_stored, totals.filtered.passed);
   EXPECT_GT(totals.track_rounds, 0u);
   EXPECT_EQ(collector.invalid(), 0);
+  // One host, one clock: LCM's receipt stamps and the camera's publish stamps agree, so latency is
+  // measured from the publish.
+  ASSERT_TRUE(totals.publish_clock_offset_us.has_value());
+  EXPECT_LT(std::abs(*totals.publish_clock_offset_us), LatencyTracker::kClocksApartUs);
+  EXPECT_EQ(totals.latency_from_receipt, 0u);
 
   const auto lists = collector.lists();
   std::size_t most_segments = 0;
