@@ -27,6 +27,7 @@
 #include "evldt/containers/ros_messages.hpp"
 #include "evldt/containers/rosbag2.hpp"
 #include "evldt/events/event_writer.hpp"
+#include "evldt/events/size_prefixed_flatbuffer.hpp"
 #include "evldt/sources/event_source.hpp"
 #include "support/raw_ros_message.hpp"
 #include "support/ros2_bag_writer.hpp"
@@ -714,6 +715,21 @@ TEST(Aedat4, FlatBuffersWithTheirSizePutInFrontReadAsDvsInEveryCompression) {
     EXPECT_EQ(result.events, from_dv.events);
     EXPECT_EQ(result.sensor, from_dv.sensor);
     EXPECT_EQ(result.name.substr(result.name.find("camera")), from_dv.name.substr(from_dv.name.find("camera")));
+  }
+}
+
+// A buffer that holds its size and nothing more (or less than a root offset) is no table, whether
+// its size field says so or not; the fuzzer found this reading an empty copy.
+TEST(Aedat4, ABufferTooShortForARootIsRefusedInEitherLayout) {
+  std::vector<std::uint64_t> scratch;
+  for (std::size_t length = 0; length < 8; ++length) {
+    for (const std::uint32_t size_field : {0u, static_cast<std::uint32_t>(length >= 4 ? length - 4 : 0), 40u}) {
+      SCOPED_TRACE(testing::Message() << length << " bytes, size field " << size_field);
+      std::vector<std::uint8_t> bytes(length, 0);
+      if (length >= 4) std::memcpy(bytes.data(), &size_field, 4);
+      EXPECT_EQ(verified_size_prefixed_root<dv::EventPacket>(bytes, scratch), nullptr);
+      EXPECT_EQ(verified_size_prefixed_root<aedat4::IOHeader>(bytes, scratch), nullptr);
+    }
   }
 }
 

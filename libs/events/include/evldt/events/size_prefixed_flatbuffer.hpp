@@ -24,7 +24,8 @@ namespace evldt {
 template <typename T>
 const T* verified_size_prefixed_root(std::span<const std::uint8_t> bytes, std::vector<std::uint64_t>& scratch) {
   constexpr std::size_t kPrefix = sizeof(flatbuffers::uoffset_t);
-  if (bytes.size() < kPrefix) return nullptr;
+  // The size and at least a root offset: anything shorter holds no table (and an empty copy has no data).
+  if (bytes.size() < 2 * kPrefix) return nullptr;
   std::uint32_t size = 0;
   std::memcpy(&size, bytes.data(), kPrefix);
   const bool sized_right = flatbuffers::EndianScalar(size) == bytes.size() - kPrefix;
