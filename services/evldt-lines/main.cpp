@@ -8,7 +8,7 @@
 
 #include "evldt/app/lcm_options.hpp"
 #include "evldt/app/pipeline_options.hpp"
-#include "evldt/lines/thread_name.hpp"
+#include "evldt/pipeline/thread_name.hpp"
 #include "evldt/nodes/lines_node.hpp"
 #include "evldt/transport/channels.hpp"
 

@@ -7,8 +7,8 @@
 #include <opencv2/calib3d.hpp>
 
 #include "evldt/calibration/camera_model.hpp"
-#include "evldt/lines/deterministic_pipeline.hpp"
-#include "evldt/lines/rectifier.hpp"
+#include "evldt/pipeline/deterministic_pipeline.hpp"
+#include "evldt/calibration/rectifier.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
 

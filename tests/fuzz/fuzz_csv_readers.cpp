@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "evldt/lines/segment_csv.hpp"
+#include "evldt/pipeline/segment_csv.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
 #include "fuzz_support.hpp"
 

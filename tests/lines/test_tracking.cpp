@@ -2,6 +2,7 @@
 
 #include "evldt/lines/detector.hpp"
 #include "evldt/lines/tracker.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
 

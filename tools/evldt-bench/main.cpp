@@ -22,10 +22,10 @@
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/calibration/camera_model.hpp"
 #include "evldt/events/event_writer.hpp"
-#include "evldt/filters/filter_chain.hpp"
+#include "evldt/pipeline/deterministic_pipeline.hpp"
+#include "evldt/pipeline/event_intake.hpp"
+#include "evldt/pipeline/whole_line_stage.hpp"
 #include "evldt/sources/event_source.hpp"
-#include "evldt/lines/deterministic_pipeline.hpp"
-#include "evldt/lines/whole_line_stage.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
@@ -277,15 +277,14 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   // whole window would time the streaming of a filtered copy as large (with its page faults in a
   // new pipeline), which no service makes.
   const std::vector<EventBatch> messages = as_messages(events);
-  EventBatch filtered;
   // A service builds its chain (and its zeroed per-pixel table) once, at start: that is timed apart
   // from the filtering, each repeat on a chain built just before it.
   std::vector<double> setup_seconds, filter_seconds;
   for (int r = 0; r <= settings.repeats; ++r) {  // the first warms the caches and is not counted
     const auto setup_start = Clock::now();
-    FilterChain chain(config.filters, config.lattice.sensor);
+    EventIntake filters_only(config);
     const auto filter_start = Clock::now();
-    for (const EventBatch& message : messages) chain.filter(message, filtered);
+    for (const EventBatch& message : messages) filters_only.prepare(message);
     const auto filter_end = Clock::now();
     if (r == 0) continue;
     setup_seconds.push_back(std::chrono::duration<double>(filter_start - setup_start).count());
@@ -302,11 +301,12 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
     lens.cy = 0.5 * scene.sensor.height - 0.5;
     lens.distortion = CameraModel::Distortion::RadialTangential;
     lens.coefficients = {-0.35, 0.15, 0.0, 0.0, 0.0};
-    const auto table = rectification_table(lens, scene.sensor);
-    EventBatch rectified;
+    PipelineConfig rectify_only = config;
+    rectify_only.filters.chain.clear();
+    rectify_only.rectification = rectification_table(lens, scene.sensor);
     f.rectify = per_item(time_op(settings, [&] {
-                           Rectifier rectifier(*table);
-                           for (const EventBatch& message : messages) rectifier.apply(message, rectified);
+                           EventIntake intake(rectify_only);
+                           for (const EventBatch& message : messages) intake.prepare(message);
                          }),
                          n);
   }

@@ -21,7 +21,7 @@
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/eval/whole_line_support.hpp"
 #include "evldt/frames/frame_reader.hpp"
-#include "evldt/lines/segment_csv.hpp"
+#include "evldt/pipeline/segment_csv.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
 #include "evldt/sources/event_source.hpp"
 #include "evldt/transport/lcm_log.hpp"

@@ -9,7 +9,7 @@
 
 #include "evldt/app/parameters.hpp"
 #include "evldt/calibration/camera_model.hpp"
-#include "evldt/lines/worker_pool.hpp"
+#include "evldt/pipeline/worker_pool.hpp"
 
 namespace evldt {
 

@@ -10,7 +10,7 @@
 
 #include "evldt/events/event_validator.hpp"
 #include "evldt/lines/normal_motion.hpp"
-#include "evldt/lines/realtime_engine.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
 
 namespace evldt {
 

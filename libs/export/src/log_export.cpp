@@ -7,7 +7,7 @@
 
 #include "evldt/containers/mcap_writer.hpp"
 #include "evldt/export/foxglove_json.hpp"
-#include "evldt/lines/params.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 #include "evldt/media/media.hpp"
 #include "evldt/render/scene_renderer.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"

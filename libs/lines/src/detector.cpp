@@ -12,12 +12,12 @@ namespace {
 constexpr std::uint64_t kNeverFailed = UINT64_MAX;
 }  // namespace
 
-LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& params, WorkerPool* pool)
+LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& params, RoundWorkers* workers)
     : geometry_(geometry),
       params_(params),
-      pool_(pool),
+      round_workers_(workers),
       retry_after_(static_cast<std::uint16_t>(std::clamp(std::floor(params.retry_share * static_cast<float>(geometry.capacity)), 0.0f, 65535.0f))) {
-  const int threads = pool ? pool->threads() : 1;
+  const int threads = workers ? workers->threads() : 1;
   const float b = static_cast<float>(geometry.block_size);
   workers_.reserve(static_cast<std::size_t>(threads));
   for (int w = 0; w < threads; ++w) {
@@ -42,8 +42,8 @@ int LineDetector::detect(const ScarfLattice& lattice, LineMap& lines, Timestamp 
       detect_row(lattice, lines, row, worker, test_bends);
     }
   };
-  if (pool_ != nullptr && geometry_.block_count() >= kMinBlocksToSplit) {
-    pool_->run(detect_claimed);
+  if (round_workers_ != nullptr && geometry_.block_count() >= kMinBlocksToSplit) {
+    round_workers_->run(detect_claimed);
   } else {
     detect_claimed(0);
   }

@@ -70,9 +70,9 @@ constexpr std::size_t kLinesPerClaim = 16;  // lines a worker claims at a time
 }  // namespace
 
 LineTracker::LineTracker(const LatticeGeometry& geometry, const ScoreParams& score, const TrackParams& track,
-                         WorkerPool* pool)
-    : geometry_(geometry), score_params_(score), params_(track), pool_(pool) {
-  const int threads = pool ? pool->threads() : 1;
+                         RoundWorkers* workers)
+    : geometry_(geometry), score_params_(score), params_(track), round_workers_(workers) {
+  const int threads = workers ? workers->threads() : 1;
   const float inlier_distance = score.inlier_distance_ratio * static_cast<float>(geometry.block_size);
   const float diagonal = std::hypot(static_cast<float>(geometry.sensor.width), static_cast<float>(geometry.sensor.height));
   const auto longest_walk = static_cast<std::size_t>(geometry.blocks_x + geometry.blocks_y + 2);
@@ -112,8 +112,8 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
       }
     }
   };
-  if (pool_ != nullptr && n >= kMinLinesToSplit) {
-    pool_->run(track_claimed);
+  if (round_workers_ != nullptr && n >= kMinLinesToSplit) {
+    round_workers_->run(track_claimed);
   } else {
     track_claimed(0);
   }

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <spdlog/spdlog.h>
 
-#include "evldt/lines/thread_name.hpp"
+#include "evldt/pipeline/thread_name.hpp"
 #include "evldt/transport/channels.hpp"
 #include "evldt/transport/messages.hpp"
 

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <spdlog/spdlog.h>
 
-#include "evldt/lines/thread_name.hpp"
+#include "evldt/pipeline/thread_name.hpp"
 #include "evldt/transport/channels.hpp"
 
 namespace evldt {

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "evldt/lines/thread_name.hpp"
+#include "evldt/pipeline/thread_name.hpp"
 #include "evldt/transport/channels.hpp"
 
 namespace evldt {

@@ -26,7 +26,7 @@
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/events/event_validator.hpp"
 #include "evldt/frames/frame_reader.hpp"
-#include "evldt/lines/deterministic_pipeline.hpp"
+#include "evldt/pipeline/deterministic_pipeline.hpp"
 #include "evldt/sources/event_source.hpp"
 
 namespace py = pybind11;

@@ -11,7 +11,7 @@
 #include <variant>
 #include <vector>
 
-#include "evldt/lines/params.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 
 namespace evldt {
 

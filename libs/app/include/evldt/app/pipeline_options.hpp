@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "evldt/lines/params.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 
 namespace evldt {
 

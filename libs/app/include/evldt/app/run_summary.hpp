@@ -7,7 +7,7 @@
 
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_validator.hpp"
-#include "evldt/lines/deterministic_pipeline.hpp"
+#include "evldt/pipeline/deterministic_pipeline.hpp"
 
 namespace evldt {
 

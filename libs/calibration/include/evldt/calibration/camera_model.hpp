@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "evldt/events/event.hpp"
-#include "evldt/lines/rectifier.hpp"
+#include "evldt/calibration/rectifier.hpp"
 
 namespace evldt {
 

@@ -9,7 +9,7 @@
 
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/frames/frame_reader.hpp"
-#include "evldt/lines/segment_csv.hpp"
+#include "evldt/pipeline/segment_csv.hpp"
 
 namespace evldt {
 

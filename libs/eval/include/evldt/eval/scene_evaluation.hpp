@@ -16,8 +16,8 @@
 #include "evldt/eval/tracking_metrics.hpp"
 #include "evldt/eval/visible_score.hpp"
 #include "evldt/eval/whole_line_support.hpp"
-#include "evldt/lines/deterministic_pipeline.hpp"
-#include "evldt/lines/segment_csv.hpp"
+#include "evldt/pipeline/deterministic_pipeline.hpp"
+#include "evldt/pipeline/segment_csv.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/ground_truth_csv.hpp"
 

@@ -13,23 +13,23 @@
 #include "evldt/lines/fitting_score.hpp"
 #include "evldt/lines/line_map.hpp"
 #include "evldt/lines/params.hpp"
-#include "evldt/lines/worker_pool.hpp"
+#include "evldt/lines/round_workers.hpp"
 
 namespace evldt {
 
 class LineDetector {
  public:
-  /// With a pool, a round's block rows are shared out among its workers (no two touch one block);
-  /// the lines are then created in block order, so the output is the same for any count. The pool
+  /// With workers, a round's block rows are shared out among its workers (no two touch one block);
+  /// the lines are then created in block order, so the output is the same for any count. The workers
   /// must outlive the detector.
-  LineDetector(const LatticeGeometry& geometry, const ScoreParams& params, WorkerPool* pool = nullptr);
+  LineDetector(const LatticeGeometry& geometry, const ScoreParams& params, RoundWorkers* workers = nullptr);
 
   /// One detection round over every block; returns the number of lines created. Without
   /// `test_bends` a block's line that clears the score is kept without the bend test (the live
   /// engine while it sheds: the test reads the blocks beyond both ends of every new line).
   int detect(const ScarfLattice& lattice, LineMap& lines, Timestamp now, bool test_bends = true);
 
-  /// A lattice of fewer blocks is detected on the calling thread: waking the pool would cost more.
+  /// A lattice of fewer blocks is detected on the calling thread: waking the workers would cost more.
   static constexpr int kMinBlocksToSplit = 1024;
 
  private:
@@ -49,7 +49,7 @@ class LineDetector {
 
   LatticeGeometry geometry_;
   ScoreParams params_;
-  WorkerPool* pool_;
+  RoundWorkers* round_workers_;
   std::vector<Worker> workers_;
   std::uint64_t versions_of_ = 0;         // the lattice whose block versions failed_at_ holds
   std::vector<std::uint64_t> failed_at_;  // per block: its version at its last failed attempt

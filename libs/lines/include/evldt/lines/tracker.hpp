@@ -9,7 +9,7 @@
 #include "evldt/lines/fitting_score.hpp"
 #include "evldt/lines/line_map.hpp"
 #include "evldt/lines/params.hpp"
-#include "evldt/lines/worker_pool.hpp"
+#include "evldt/lines/round_workers.hpp"
 
 namespace evldt {
 
@@ -32,10 +32,10 @@ inline constexpr float kSuppressRatio = 0.4f;
 
 class LineTracker {
  public:
-  /// With a pool, a round's lines are tracked by its workers; the output is the same for any count.
-  /// The pool must outlive the tracker.
+  /// With workers, a round's lines are tracked by its workers; the output is the same for any count.
+  /// The workers must outlive the tracker.
   LineTracker(const LatticeGeometry& geometry, const ScoreParams& score, const TrackParams& track,
-              WorkerPool* pool = nullptr);
+              RoundWorkers* workers = nullptr);
 
   /// One tracking round over every line, followed by the manager. A line whose blocks have not
   /// changed since a pass that left it in place is not scored again: the pass would repeat itself.
@@ -43,7 +43,7 @@ class LineTracker {
   /// Line passes that reused a settled line's score instead of scoring it again.
   [[nodiscard]] std::uint64_t settled_passes() const;
 
-  /// A round with fewer lines runs on the calling thread: waking the pool would cost more.
+  /// A round with fewer lines runs on the calling thread: waking the workers would cost more.
   static constexpr std::size_t kMinLinesToSplit = 64;
 
  private:
@@ -64,7 +64,7 @@ class LineTracker {
   LatticeGeometry geometry_;
   ScoreParams score_params_;
   TrackParams params_;
-  WorkerPool* pool_;
+  RoundWorkers* round_workers_;
   std::vector<Worker> workers_;
   /// Per line of the round: kKept, or the ReleaseReason it ends with. Lines are tracked first and
   /// released after, in the order one pass down the list would release them.

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "evldt/lines/realtime_engine.hpp"
-#include "evldt/lines/whole_line_stage.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
+#include "evldt/pipeline/whole_line_stage.hpp"
 #include "evldt/nodes/lines_ingest.hpp"
 #include "evldt/nodes/lines_options.hpp"
 #include "evldt/camera_info_t.hpp"

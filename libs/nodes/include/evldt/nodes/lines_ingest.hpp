@@ -12,7 +12,7 @@
 #include <mutex>
 #include <span>
 
-#include "evldt/lines/realtime_engine.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
 #include "evldt/nodes/lines_options.hpp"
 #include "evldt/transport/payload_queue.hpp"
 

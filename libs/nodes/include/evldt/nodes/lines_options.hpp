@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "evldt/lines/params.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 #include "evldt/transport/latency_budget.hpp"
 #include "evldt/transport/latency_tracker.hpp"

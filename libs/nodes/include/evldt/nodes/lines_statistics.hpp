@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 
-#include "evldt/lines/realtime_engine.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
 #include "evldt/nodes/lines_options.hpp"
 
 namespace evldt {

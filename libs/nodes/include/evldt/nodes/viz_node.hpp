@@ -11,7 +11,7 @@
 #include <optional>
 #include <string>
 
-#include "evldt/lines/params.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 #include "evldt/render/scene_renderer.hpp"
 #include "evldt/render/line_picture.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"

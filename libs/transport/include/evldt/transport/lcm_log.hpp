@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "evldt/lines/segment_csv.hpp"
+#include "evldt/pipeline/segment_csv.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 #include "evldt/transport/lcm_log_reader.hpp"
 

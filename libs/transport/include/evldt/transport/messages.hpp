@@ -15,7 +15,7 @@
 #include "evldt/segment_list_t.hpp"
 #include "evldt/stats_t.hpp"
 #include "evldt/camera_info_t.hpp"
-#include "evldt/lines/rectifier.hpp"
+#include "evldt/calibration/rectifier.hpp"
 
 namespace evldt {
 

@@ -1,4 +1,4 @@
-#include "evldt/lines/params.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 
 #include <array>
 #include <cstdlib>

@@ -1,4 +1,4 @@
-#include "evldt/lines/deterministic_pipeline.hpp"
+#include "evldt/pipeline/deterministic_pipeline.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -8,7 +8,7 @@ namespace evldt {
 
 DeterministicPipeline::DeterministicPipeline(const PipelineConfig& config, bool keep_surface)
     : config_(config),
-      filters_(config.filters, config.lattice.sensor),
+      intake_(config),
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha, keep_surface),
       lines_(lattice_.geometry(), config.track.reassociation, config.track.motion),
       pool_(config.threads),
@@ -17,7 +17,6 @@ DeterministicPipeline::DeterministicPipeline(const PipelineConfig& config, bool 
   if (config.schedule.track_period_us <= 0 || config.schedule.detect_period_us <= 0) {
     throw std::invalid_argument("tracking and detection periods must be positive");
   }
-  if (config_.rectification) rectifier_.emplace(*config_.rectification);
 }
 
 void DeterministicPipeline::set_output(Timestamp period_us, StepCallback on_step, bool whole_lines) {
@@ -54,24 +53,21 @@ void DeterministicPipeline::update_next_due() {
 
 void DeterministicPipeline::process(const EventBatch& batch, int copies) {
   if (batch.empty()) return;
-  if (filters_.empty()) {
-    process_filtered(batch, batch, copies);  // no copy through filter()
-  } else {
-    filter(batch, filtered_);
-    process_filtered(batch, filtered_, copies);
-  }
+  start_or_restart(batch);
+  store(intake_.prepare(batch), copies);
+  finish_batch(batch);
 }
 
-void DeterministicPipeline::filter(const EventBatch& batch, EventBatch& filtered) {
-  if (filters_.empty()) {
-    filtered = batch;
-  } else {
-    filters_.filter(batch, filtered);
-  }
-}
+void DeterministicPipeline::filter(const EventBatch& batch, EventBatch& filtered) { intake_.filter(batch, filtered); }
 
 void DeterministicPipeline::process_filtered(const EventBatch& batch, const EventBatch& filtered, int copies) {
   if (batch.empty()) return;
+  start_or_restart(batch);
+  store(intake_.rectify(filtered), copies);
+  finish_batch(batch);
+}
+
+void DeterministicPipeline::start_or_restart(const EventBatch& batch) {
   // The schedule follows the input's clock: events the filters drop still move event time on.
   if (!started_) {
     start(batch.t[0]);
@@ -79,13 +75,10 @@ void DeterministicPipeline::process_filtered(const EventBatch& batch, const Even
     ++counters_.clock_restarts;
     start(batch.t[0]);
   }
-  if (rectifier_) {
-    rectifier_->apply(filtered, rectified_);
-    counters_.off_rectified = rectifier_->dropped();
-    store(rectified_, copies);
-  } else {
-    store(filtered, copies);
-  }
+}
+
+void DeterministicPipeline::finish_batch(const EventBatch& batch) {
+  counters_.off_rectified = intake_.off_rectified();
   // Rounds due up to the batch's last event: every stored event is older than them (store() ran
   // each round due at or before a stored event's time before storing it).
   if (batch.t.back() >= next_due_) run_rounds_until(batch.t.back());

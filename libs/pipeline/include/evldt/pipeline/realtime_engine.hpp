@@ -23,6 +23,9 @@
 
 #include "evldt/lines/detector.hpp"
 #include "evldt/lines/tracker.hpp"
+#include "evldt/pipeline/event_intake.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
+#include "evldt/pipeline/worker_pool.hpp"
 
 namespace evldt {
 
@@ -111,11 +114,8 @@ class RealtimeEngine {
   void loop(const char* thread_name, LoopState& state, std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round);
 
   PipelineConfig config_;
-  mutable std::mutex filter_mutex_;           // the producer filters under it; counters() reads under it
-  FilterChain filters_;                       // guarded by filter_mutex_
-  EventBatch filtered_;                       // the producer's, reused
-  std::optional<Rectifier> rectifier_;        // with a calibration; guarded by filter_mutex_
-  EventBatch rectified_;                      // the producer's, reused
+  mutable std::mutex intake_mutex_;           // the producer filters under it; counters() reads under it
+  EventIntake intake_;                        // guarded by intake_mutex_
   ScarfLattice lattice_;                      // guarded by lattice_mutex_
   mutable std::mutex lattice_mutex_;
   std::condition_variable lattice_changed_;

@@ -12,7 +12,10 @@
 
 #include "evldt/lines/detector.hpp"
 #include "evldt/lines/tracker.hpp"
-#include "evldt/lines/whole_line_stage.hpp"
+#include "evldt/pipeline/event_intake.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
+#include "evldt/pipeline/whole_line_stage.hpp"
+#include "evldt/pipeline/worker_pool.hpp"
 
 namespace evldt {
 
@@ -65,24 +68,23 @@ class DeterministicPipeline {
   [[nodiscard]] LineMap& lines() { return lines_; }
   [[nodiscard]] const ScarfLattice& lattice() const { return lattice_; }
   [[nodiscard]] const PipelineCounters& counters() const { return counters_; }
-  [[nodiscard]] FilterCounts filter_counts() const { return filters_.counts(); }
-  [[nodiscard]] const FilterChain& filters() const { return filters_; }
+  [[nodiscard]] FilterCounts filter_counts() const { return intake_.filter_counts(); }
+  [[nodiscard]] const FilterChain& filters() const { return intake_.filters(); }
   [[nodiscard]] const PipelineConfig& config() const { return config_; }
   /// The whole-line stage, when set_output asked for whole lines.
   [[nodiscard]] const WholeLineStage* whole_lines() const { return whole_lines_ ? &*whole_lines_ : nullptr; }
 
  private:
+  void start_or_restart(const EventBatch& batch);  // at a batch's first event
   void store(const EventBatch& batch, int copies);
+  void finish_batch(const EventBatch& batch);  // the rounds due by its last event
   void start(Timestamp t0);
   void run_rounds_until(Timestamp t);  // every round due at a time <= t
   void skip_gap(Timestamp t);
   void update_next_due();
 
   PipelineConfig config_;
-  FilterChain filters_;
-  EventBatch filtered_;  // what passed the filters, reused
-  std::optional<Rectifier> rectifier_;  // with a calibration
-  EventBatch rectified_;                // what passed the filters, in the rectified image, reused
+  EventIntake intake_;
   ScarfLattice lattice_;
   LineMap lines_;
   WorkerPool pool_;  // config.threads; shared by the detector and the tracker

@@ -1,4 +1,4 @@
-#include "evldt/lines/segment_csv.hpp"
+#include "evldt/pipeline/segment_csv.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -5,8 +5,8 @@
 #include <set>
 #include <thread>
 
-#include "evldt/lines/deterministic_pipeline.hpp"
-#include "evldt/lines/realtime_engine.hpp"
+#include "evldt/pipeline/deterministic_pipeline.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
 #include "support/sweeping_edge.hpp"

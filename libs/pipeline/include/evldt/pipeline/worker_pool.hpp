@@ -1,6 +1,6 @@
 #pragma once
-// A fixed set of threads that run one task together: tracking and detection rounds split their work
-// over it. The caller's thread is worker 0, so a pool of one thread starts none and runs inline.
+// A fixed set of threads that run one task together: the workers tracking and detection rounds split
+// their work over. The caller's thread is worker 0, so a pool of one thread starts none and runs inline.
 
 #include <condition_variable>
 #include <cstdint>
@@ -8,31 +8,22 @@
 #include <thread>
 #include <vector>
 
+#include "evldt/lines/round_workers.hpp"
+
 namespace evldt {
 
-class WorkerPool {
+class WorkerPool final : public RoundWorkers {
  public:
   /// `threads` >= 1 workers in all, the caller's thread among them.
   explicit WorkerPool(int threads);
-  ~WorkerPool();
+  ~WorkerPool() override;
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
-  [[nodiscard]] int threads() const { return static_cast<int>(threads_.size()) + 1; }
-
-  /// Calls task(0) on the calling thread, and task(worker) on each other worker that wakes before
-  /// that call returns; returns when every call has. So the task must share its work out as it goes
-  /// (workers claim parts from a counter), never by worker: a worker that wakes late, and a round too
-  /// small to wait for it, do not hold the caller up. The task must not throw. Callers on several
-  /// threads take turns. Allocation-free: the task is passed by reference.
-  template <typename Task>
-  void run(Task& task) {
-    run_erased([](void* context, int worker) { (*static_cast<Task*>(context))(worker); }, &task);
-  }
+  [[nodiscard]] int threads() const override { return static_cast<int>(threads_.size()) + 1; }
 
  private:
-  using Erased = void (*)(void*, int);
-  void run_erased(Erased function, void* context);
+  void run_erased(Erased function, void* context) override;
   void work(int worker);
 
   std::mutex turn_;  // one run() at a time

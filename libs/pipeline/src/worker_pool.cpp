@@ -1,9 +1,9 @@
-#include "evldt/lines/worker_pool.hpp"
+#include "evldt/pipeline/worker_pool.hpp"
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "evldt/lines/thread_name.hpp"
+#include "evldt/pipeline/thread_name.hpp"
 
 namespace evldt {
 

@@ -1,11 +1,11 @@
-#include "evldt/lines/realtime_engine.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <limits>
 #include <stdexcept>
 
-#include "evldt/lines/thread_name.hpp"
+#include "evldt/pipeline/thread_name.hpp"
 
 namespace evldt {
 
@@ -18,7 +18,7 @@ constexpr std::size_t kPreparedBatch = std::size_t{1} << 16;
 
 RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
     : config_(config),
-      filters_(config.filters, config.lattice.sensor),
+      intake_(config, kPreparedBatch),
       lattice_(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha),
       detect_{ScarfLattice(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha)},
       track_{ScarfLattice(config.lattice.sensor, config.lattice.block_size, config.lattice.alpha)},
@@ -26,11 +26,6 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
       pool_(config.threads),
       detector_(lattice_.geometry(), config.score, &pool_),
       tracker_(lattice_.geometry(), config.score, config.track, &pool_) {
-  filtered_.reserve_touched(kPreparedBatch);
-  if (config_.rectification) {
-    rectifier_.emplace(*config_.rectification);
-    rectified_.reserve_touched(kPreparedBatch);
-  }
   if (config.schedule.shedding_period_factor < 1) throw std::invalid_argument("shedding_period_factor must be at least 1");
   if (config.schedule.input_pause_ms < 1) throw std::invalid_argument("input_pause_ms must be at least 1");
 }
@@ -71,19 +66,12 @@ void RealtimeEngine::stop() {
 void RealtimeEngine::process(const EventBatch& input, int copies) {
   if (input.empty()) return;
   storing_.store(true, std::memory_order_relaxed);
-  const EventBatch* stored = &input;
+  const EventBatch* prepared = nullptr;
   {
-    std::lock_guard lock(filter_mutex_);
-    if (!filters_.empty()) {
-      filters_.filter(input, filtered_);
-      stored = &filtered_;
-    }
-    if (rectifier_) {  // onto the rectified image, after the filters (which work on sensor pixels)
-      rectifier_->apply(*stored, rectified_);
-      stored = &rectified_;
-    }
+    std::lock_guard lock(intake_mutex_);
+    prepared = &intake_.prepare(input);  // the intake's buffer is the producer's alone
   }
-  const EventBatch& batch = *stored;
+  const EventBatch& batch = *prepared;
   const std::size_t n = batch.size();
   // Chunks of the stored events; the last (or only, when the filters dropped all) also takes in the
   // input's time, since events the filters dropped still move event time on.
@@ -229,17 +217,17 @@ void RealtimeEngine::copy_lattice(ScarfLattice& view) const {
 }
 
 std::vector<std::uint32_t> RealtimeEngine::masked_pixels() const {
-  std::lock_guard lock(filter_mutex_);
-  const auto masked = filters_.masked_pixels();
+  std::lock_guard lock(intake_mutex_);
+  const auto masked = intake_.masked_pixels();
   return {masked.begin(), masked.end()};
 }
 
 EngineCounters RealtimeEngine::counters() const {
   EngineCounters c;
   {
-    std::lock_guard lock(filter_mutex_);
-    c.filtered = filters_.counts();
-    c.off_rectified = rectifier_ ? rectifier_->dropped() : 0;
+    std::lock_guard lock(intake_mutex_);
+    c.filtered = intake_.filter_counts();
+    c.off_rectified = intake_.off_rectified();
   }
   {
     std::lock_guard lock(lattice_mutex_);

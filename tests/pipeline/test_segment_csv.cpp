@@ -3,7 +3,7 @@
 #include <cmath>
 #include <fstream>
 
-#include "evldt/lines/segment_csv.hpp"
+#include "evldt/pipeline/segment_csv.hpp"
 
 namespace evldt {
 namespace {

@@ -7,7 +7,7 @@
 #include <span>
 #include <vector>
 
-#include "evldt/lines/params.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 #include "evldt/lines/whole_lines.hpp"
 
 namespace evldt {

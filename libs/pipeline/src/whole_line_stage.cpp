@@ -1,4 +1,4 @@
-#include "evldt/lines/whole_line_stage.hpp"
+#include "evldt/pipeline/whole_line_stage.hpp"
 
 namespace evldt {
 

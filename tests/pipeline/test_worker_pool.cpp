@@ -4,7 +4,7 @@
 #include <thread>
 #include <vector>
 
-#include "evldt/lines/worker_pool.hpp"
+#include "evldt/pipeline/worker_pool.hpp"
 
 namespace evldt {
 namespace {
