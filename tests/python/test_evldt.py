@@ -172,6 +172,22 @@ def test_python_threads_may_share_a_pipeline(boxes):
     np.testing.assert_array_equal(np.concatenate([results[0], results[1]]), alone)
 
 
+def assert_same_figures(mine, theirs, where):
+    """The same JSON value, numbers within rounding."""
+    if isinstance(theirs, dict):
+        assert set(mine) == set(theirs), where
+        for key in theirs:
+            assert_same_figures(mine[key], theirs[key], f"{where}.{key}")
+    elif isinstance(theirs, list):
+        assert len(mine) == len(theirs), where
+        for i, (a, b) in enumerate(zip(mine, theirs)):
+            assert_same_figures(a, b, f"{where}[{i}]")
+    elif isinstance(theirs, float):
+        assert mine == pytest.approx(theirs, abs=1e-12), where
+    else:
+        assert mine == theirs, where
+
+
 def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
     # The same numbers both ways: evldt-offline's CSV and evldt-sim's ground truth, read into numpy.
     path = recording(boxes, "evt3")
@@ -194,24 +210,19 @@ def test_evaluate_gives_evldt_eval_figures(boxes, tmp_path):
         truth[field] = [float(r[field]) for r in truth_rows]
     got = evldt.evaluate(segments, truth, 240, 180)
     assert len(got["accuracy"]) == 2
-    for mine, theirs in zip(got["accuracy"], reference["accuracy"]):
-        for key in ("tolerance", "precision", "recall", "f"):
-            assert mine[key] == pytest.approx(theirs[key], abs=1e-12), key
     assert 0.5 < got["accuracy"][0]["f"] < 1
-    assert got["ids"] == reference["lifetime"]["ids"]
-    assert got["lifetime_mean_ms"] == pytest.approx(reference["lifetime"]["mean_ms"])
-    assert got["coverage"] == pytest.approx(reference["tracking"]["coverage"])
-    assert got["idf1"] == pytest.approx(reference["tracking"]["idf1"])
-    assert got["vel_err_med"] == pytest.approx(reference["tracking"]["vel_err_med"])
-    assert got["vel_rel_med"] == pytest.approx(reference["tracking"]["vel_rel_med"])
+    assert got["tracking"]["vel_rel_med"] is not None
+    # One report: every figure of evldt-eval's run under the same key, besides the run's own fields.
+    own = {"run", "fit_threshold", "events", "scene_seconds", "wall_seconds", "visible_only"}
+    assert set(got) == set(reference) - own
+    for key in got:
+        assert_same_figures(got[key], reference[key], key)
     assert "visible_only" not in got
     # What an events-only camera can see, as evldt-eval --visible-only scores it.
     visible = evldt.evaluate(segments, truth, 240, 180, min_normal_speed=2)["visible_only"]
     theirs = reference["visible_only"]
-    assert visible["visible_share"] == pytest.approx(theirs["visible_share"]) and 0.5 < visible["visible_share"] <= 1
-    for mine, expected in zip(visible["accuracy"], theirs["accuracy"]):
-        for key in ("tolerance", "precision", "recall", "f"):
-            assert mine[key] == pytest.approx(expected[key], abs=1e-12), key
+    assert 0.5 < visible["visible_share"] <= 1
+    assert_same_figures(visible, theirs, "visible_only")
     # The same run on a clock of Unix-epoch microseconds, as DV writes them: the same figures.
     epoch = 1_600_000_000_000_000
     segments["t"] += epoch

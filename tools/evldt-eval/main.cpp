@@ -14,6 +14,7 @@
 
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/simulator_options.hpp"
+#include "evldt/eval/evaluation_report.hpp"
 #include "evldt/eval/frame_ground_truth.hpp"
 #include "evldt/eval/overlay.hpp"
 #include "evldt/json/json_writer.hpp"
@@ -87,18 +88,8 @@ struct Report {
   std::string label;
   std::optional<float> threshold;  ///< set for pipeline runs; a segment file's is unknown
   bool whole_lines = false;        ///< the whole lines of a pipeline run
-  std::vector<Prf> summed;
-  double mean_predicted = 0, mean_ground_truth = 0;
-  std::uint64_t steps = 0;
-  StepCoverage coverage;
-  Timestamp hold_us = 0;
-  LifetimeSummary lifetime;
-  TrackingSummary tracking;
+  EvaluationReport figures;
   std::optional<SupportSummary> support;  ///< whole lines: their support by the segments of their step
-  std::vector<Prf> visible;               ///< --visible-only: against the true edges moving fast enough to be seen
-  double visible_share = 0;               ///< of the true pixels, those moving fast enough
-  std::vector<StreamEvaluator::Second> per_second;  ///< cumulative, at the first tolerance
-  std::optional<Timestamp> seconds_origin;          ///< t0 of per_second
   std::vector<EdgeStep> edge_steps;       ///< with --edge-recall: each true edge at each step
   std::uint64_t events = 0;
   double scene_seconds = 0, wall_seconds = 0;
@@ -106,22 +97,7 @@ struct Report {
 
 Report make_report(const StreamEvaluator& evaluator) {
   Report r;
-  const auto& a = evaluator.accuracy();
-  for (std::size_t i = 0; i < a.tolerance_fractions().size(); ++i) r.summed.push_back(a.summed_prf(i));
-  r.mean_predicted = a.mean_predicted_segments();
-  r.mean_ground_truth = a.mean_ground_truth_segments();
-  r.steps = a.steps();
-  r.coverage = evaluator.coverage();
-  r.hold_us = evaluator.hold_us();
-  r.lifetime = evaluator.lifetimes().summary();
-  r.tracking = evaluator.tracking().summary();
-  r.per_second = evaluator.per_second();
-  if (const auto& visible = evaluator.visible_accuracy()) {
-    for (std::size_t i = 0; i < visible->tolerance_fractions().size(); ++i) r.visible.push_back(visible->summed_prf(i));
-    const auto seen = static_cast<double>(evaluator.visible_truth_pixels()), unseen = static_cast<double>(evaluator.hidden_truth_pixels());
-    r.visible_share = seen + unseen > 0 ? seen / (seen + unseen) : std::numeric_limits<double>::quiet_NaN();
-  }
-  r.seconds_origin = evaluator.seconds_origin();
+  r.figures = make_evaluation_report(evaluator);
   if (evaluator.edge_recall()) r.edge_steps = evaluator.edge_recall()->steps();
   return r;
 }
@@ -221,14 +197,15 @@ void print_table(const std::vector<Report>& reports, const Options& options) {
     } else {
       std::printf("%-24s %6s", r.label.c_str(), "-");
     }
-    for (const Prf& p : r.summed) std::printf("  %6s  %6s  %6s", figure(p.precision).c_str(), figure(p.recall).c_str(), figure(p.f).c_str());
-    std::printf("  %9.1f  %7.1f  %8llu  %7llu  %4llu  %11.1f %11.1f  %5s  %6s  %5llu  %5s  %11s  %11s\n", r.mean_predicted,
-                r.mean_ground_truth, static_cast<unsigned long long>(r.coverage.ground_truth_steps),
-                static_cast<unsigned long long>(r.coverage.steps_without_prediction),
-                static_cast<unsigned long long>(r.lifetime.count), r.lifetime.mean_ms, r.lifetime.max_ms,
-                figure(r.tracking.coverage).c_str(), figure(r.tracking.ids_per_line, 1).c_str(),
-                static_cast<unsigned long long>(r.tracking.id_switches), figure(r.tracking.idf1).c_str(),
-                figure(r.tracking.velocity_error_median, 1).c_str(), figure(r.tracking.velocity_relative_median).c_str());
+    const EvaluationReport& e = r.figures;
+    for (const Prf& p : e.accuracy) std::printf("  %6s  %6s  %6s", figure(p.precision).c_str(), figure(p.recall).c_str(), figure(p.f).c_str());
+    std::printf("  %9.1f  %7.1f  %8llu  %7llu  %4llu  %11.1f %11.1f  %5s  %6s  %5llu  %5s  %11s  %11s\n", e.mean_predicted,
+                e.mean_ground_truth, static_cast<unsigned long long>(e.coverage.ground_truth_steps),
+                static_cast<unsigned long long>(e.coverage.steps_without_prediction),
+                static_cast<unsigned long long>(e.lifetime.count), e.lifetime.mean_ms, e.lifetime.max_ms,
+                figure(e.tracking.coverage).c_str(), figure(e.tracking.ids_per_line, 1).c_str(),
+                static_cast<unsigned long long>(e.tracking.id_switches), figure(e.tracking.idf1).c_str(),
+                figure(e.tracking.velocity_error_median, 1).c_str(), figure(e.tracking.velocity_relative_median).c_str());
   }
 }
 
@@ -243,9 +220,9 @@ void print_visible(const std::vector<Report>& reports, const Options& options) {
   }
   std::printf("\n");
   for (const Report& r : reports) {
-    if (r.visible.empty()) continue;
-    std::printf("%-32s %8s", (r.label + " visible").c_str(), figure(r.visible_share).c_str());
-    for (const Prf& p : r.visible) std::printf("  %6s  %6s  %6s", figure(p.precision).c_str(), figure(p.recall).c_str(), figure(p.f).c_str());
+    if (r.figures.visible.empty()) continue;
+    std::printf("%-32s %8s", (r.label + " visible").c_str(), figure(r.figures.visible_share).c_str());
+    for (const Prf& p : r.figures.visible) std::printf("  %6s  %6s  %6s", figure(p.precision).c_str(), figure(p.recall).c_str(), figure(p.f).c_str());
     std::printf("\n");
   }
 }
@@ -253,7 +230,7 @@ void print_visible(const std::vector<Report>& reports, const Options& options) {
 // Why ids changed, and what identity cost in length: a line per run that had switches.
 void print_switch_causes(const std::vector<Report>& reports) {
   for (const Report& r : reports) {
-    const TrackingSummary& t = r.tracking;
+    const TrackingSummary& t = r.figures.tracking;
     if (t.id_switches == 0) continue;
     const IdSwitchCauses& c = t.switch_causes;
     std::printf("id switches of %s: %llu to another edge, %llu off the edge, %llu returned later, %llu detected again, "
@@ -330,9 +307,10 @@ void print_per_second(const std::vector<Report>& reports, const Options& options
   const auto number = [](double value) { return std::isfinite(value) ? fmt::format("{:.3f}", value) : std::string("n/a"); };
   for (const Report& r : reports) {
     std::string row = fmt::format("{:<26}", r.label);
-    if (r.seconds_origin) row += fmt::format(" t0 {:.0f} s:", static_cast<double>(*r.seconds_origin) * 1e-6);
-    for (std::size_t k = 0; k < std::min(kSeconds, r.per_second.size()); ++k) {
-      const StreamEvaluator::Second& second = r.per_second[k];
+    const EvaluationReport& e = r.figures;
+    if (e.seconds_origin) row += fmt::format(" t0 {:.0f} s:", static_cast<double>(*e.seconds_origin) * 1e-6);
+    for (std::size_t k = 0; k < std::min(kSeconds, e.per_second.size()); ++k) {
+      const StreamEvaluator::Second& second = e.per_second[k];
       row += fmt::format("  {}-{} s ", k, k + 1);
       row += second.steps == 0 ? std::string("-")
                                : number(second.cumulative.precision) + " / " + number(second.cumulative.recall);
@@ -353,53 +331,8 @@ void write_json(const std::vector<Report>& reports, const Options& options) {
     } else {
       json.null();
     }
-    json.key("steps").value(r.steps).key("events").value(r.events).key("scene_seconds").value(r.scene_seconds);
-    json.key("coverage").begin_object().key("ground_truth_steps").value(r.coverage.ground_truth_steps);
-    json.key("steps_without_prediction").value(r.coverage.steps_without_prediction);
-    json.key("prediction_hold_us").value(static_cast<std::int64_t>(r.hold_us));
-    json.key("predicted_steps").value(r.coverage.predicted_steps);
-    json.key("predicted_steps_scored").value(r.coverage.predicted_steps_scored);
-    json.key("predicted_steps_outside_ground_truth").value(r.coverage.predicted_steps_outside).end_object();
-    json.key("wall_seconds").value(r.wall_seconds);
-    json.key("accuracy").begin_array();
-    for (std::size_t i = 0; i < r.summed.size(); ++i) {
-      json.begin_object().key("tolerance").value(options.tolerances[i]).key("precision").value(r.summed[i].precision);
-      json.key("recall").value(r.summed[i].recall).key("f").value(r.summed[i].f).end_object();
-    }
-    json.end_array();
-    if (!r.visible.empty()) {
-      json.key("visible_only").begin_object().key("min_normal_speed").value(static_cast<double>(options.min_normal_speed));
-      json.key("visible_share").value(r.visible_share).key("accuracy").begin_array();
-      for (std::size_t i = 0; i < r.visible.size(); ++i) {
-        json.begin_object().key("tolerance").value(options.tolerances[i]).key("precision").value(r.visible[i].precision);
-        json.key("recall").value(r.visible[i].recall).key("f").value(r.visible[i].f).end_object();
-      }
-      json.end_array().end_object();
-    }
-    json.key("cumulative_per_second").begin_array();
-    for (const StreamEvaluator::Second& second : r.per_second) {
-      const Prf& p = second.cumulative;
-      json.begin_object().key("steps").value(second.steps);
-      json.key("precision").value(p.precision).key("recall").value(p.recall).key("f").value(p.f).end_object();
-    }
-    json.end_array();
-    json.key("mean_segments_per_step").value(r.mean_predicted).key("mean_gt_segments_per_step").value(r.mean_ground_truth);
-    json.key("lifetime").begin_object().key("ids").value(r.lifetime.count).key("mean_ms").value(r.lifetime.mean_ms);
-    json.key("std_ms").value(r.lifetime.std_ms).key("max_ms").value(r.lifetime.max_ms).end_object();
-    const TrackingSummary& t = r.tracking;
-    json.key("tracking").begin_object().key("tolerance").value(options.tolerances.front());
-    json.key("min_overlap").value(kDefaultMinOverlap).key("ground_truth_lines").value(t.ground_truth_lines);
-    json.key("lines_never_matched").value(t.lines_never_matched).key("coverage").value(t.coverage);
-    json.key("ids_per_line").value(t.ids_per_line).key("id_switches").value(t.id_switches);
-    json.key("id_precision").value(t.id_precision).key("id_recall").value(t.id_recall).key("idf1").value(t.idf1);
-    json.key("unassigned_matched_px").value(t.unassigned_matched_px);
-    json.key("velocity_pairs").value(t.velocity_pairs).key("vel_err_med").value(t.velocity_error_median);
-    json.key("vel_rel_med").value(t.velocity_relative_median);
-    const IdSwitchCauses& c = t.switch_causes;
-    json.key("id_switch_causes").begin_object().key("to_other_edge").value(c.to_other_edge).key("off_edge").value(c.off_edge);
-    json.key("returned").value(c.returned).key("redetected").value(c.redetected).key("taken_over").value(c.taken_over);
-    json.key("after_gap").value(c.after_gap).end_object();
-    json.end_object();
+    json.key("events").value(r.events).key("scene_seconds").value(r.scene_seconds).key("wall_seconds").value(r.wall_seconds);
+    write_evaluation_json(json, r.figures);
     if (r.support) write_support_json(json, *r.support);
     json.end_object();
   }
@@ -428,7 +361,7 @@ void write_run_plots(const Options& options, const StreamEvaluator& evaluator, c
   }
   if (!options.tracks_png.empty()) {
     write_id_timeline_png(run_path(options.tracks_png, report, several_runs), evaluator.tracking().lines(),
-                          report.label + fmt::format(" ids over time (IDF1 {})", figure(report.tracking.idf1)));
+                          report.label + fmt::format(" ids over time (IDF1 {})", figure(report.figures.tracking.idf1)));
   }
   if (!options.edge_recall_png.empty() && evaluator.edge_recall()) {
     const auto path = run_path(options.edge_recall_png, report, several_runs);
@@ -584,7 +517,7 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
   if (!options.json.empty()) write_json(reports, options);
   if (!options.pr_png.empty()) {
     std::vector<PrPoint> points;
-    for (const Report& r : reports) points.push_back({r.threshold.value_or(0.0f), r.summed[0].precision, r.summed[0].recall, r.summed[0].f});
+    for (const Report& r : reports) points.push_back({r.threshold.value_or(0.0f), r.figures.accuracy[0].precision, r.figures.accuracy[0].recall, r.figures.accuracy[0].f});
     write_pr_curve_png(options.pr_png, points, reports.front().label + " PR over f_th (tolerance " +
                                                    std::to_string(options.tolerances[0] * 100).substr(0, 3) + "% of diagonal)");
   }

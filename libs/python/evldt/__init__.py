@@ -136,10 +136,12 @@ class Pipeline:
 
 def evaluate(segments, ground_truth, width, height, tolerances=(0.01, 0.02), output_period_us=0, min_normal_speed=None):
     """evldt-eval's figures for predicted segments (SEGMENT_DTYPE, or any structured array with t,
-    id, x0, y0, x1, y1, and normal_velocity if known) against ground truth (GROUND_TRUTH_DTYPE: t, gt_id, x0, y0, x1, y1):
-    precision, recall and F at each tolerance (a fraction of the image diagonal), id lifetimes and
-    the tracking metrics; vel_err_med and vel_rel_med compare normal velocities (None: the rows
-    carry none). output_period_us 0: the median spacing of the predicted steps. With
+    id, x0, y0, x1, y1, and normal_velocity if known) against ground truth (GROUND_TRUTH_DTYPE: t, gt_id, x0, y0, x1, y1),
+    as a dict with the keys of a run of `evldt-eval --json` (docs/tools.md): "accuracy" (precision,
+    recall and F at each tolerance, a fraction of the image diagonal), "lifetime", "tracking" (IDF1,
+    id switches and their causes; vel_err_med and vel_rel_med compare normal velocities, None where
+    the rows carry none), "coverage", "cumulative_per_second", "mean_segments_per_step". An undefined
+    ratio is None. output_period_us 0: the median spacing of the predicted steps. With
     min_normal_speed (px/s; evldt-eval --visible-only's 2 is the usual), also "visible_only": the
     score against the true edges moving across themselves at that speed or more, and their share
     of the true pixels."""

@@ -23,6 +23,7 @@
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/client/line_subscriber.hpp"
 #include "evldt/app/simulator_options.hpp"
+#include "evldt/eval/evaluation_report.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/events/event_validator.hpp"
 #include "evldt/frames/frame_reader.hpp"
@@ -271,16 +272,8 @@ class Pipeline {
   std::vector<SegmentRecord> completed_whole_;  // whole_steps_ of the last process()
 };
 
-py::dict prf_dict(const Prf& prf) {
-  py::dict out;
-  out["precision"] = prf.precision;
-  out["recall"] = prf.recall;
-  out["f"] = prf.f;
-  return out;
-}
-
 /// evldt-eval's figures of predicted segments against ground truth.
-py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<GroundTruthRecord>& ground_truth,
+py::object evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<GroundTruthRecord>& ground_truth,
                   int width, int height, const std::vector<double>& tolerances, Timestamp output_period_us,
                   std::optional<float> min_normal_speed) {
   if (min_normal_speed && !(*min_normal_speed >= 0)) throw py::value_error("min_normal_speed must not be negative");
@@ -310,48 +303,8 @@ py::dict evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<
                                             min_normal_speed ? std::optional<VisibleOnly>(VisibleOnly::by_speed(*min_normal_speed))
                                                              : std::nullopt));
   }
-  py::dict out;
-  py::list by_tolerance;
-  const auto& accuracy = evaluator->accuracy();
-  for (std::size_t i = 0; i < tolerances.size(); ++i) {
-    py::dict entry = prf_dict(accuracy.summed_prf(i));
-    entry["tolerance"] = tolerances[i];
-    by_tolerance.append(entry);
-  }
-  out["accuracy"] = by_tolerance;
-  if (const auto& visible = evaluator->visible_accuracy()) {
-    py::dict visible_only;
-    py::list visible_by_tolerance;
-    for (std::size_t i = 0; i < tolerances.size(); ++i) {
-      py::dict entry = prf_dict(visible->summed_prf(i));
-      entry["tolerance"] = tolerances[i];
-      visible_by_tolerance.append(entry);
-    }
-    const auto seen = static_cast<double>(evaluator->visible_truth_pixels());
-    const auto unseen = static_cast<double>(evaluator->hidden_truth_pixels());
-    visible_only["min_normal_speed"] = *min_normal_speed;
-    visible_only["visible_share"] = seen + unseen > 0 ? seen / (seen + unseen) : std::numeric_limits<double>::quiet_NaN();
-    visible_only["accuracy"] = visible_by_tolerance;
-    out["visible_only"] = visible_only;
-  }
-  out["steps"] = accuracy.steps();
-  out["mean_predicted_segments"] = accuracy.mean_predicted_segments();
-  out["mean_ground_truth_segments"] = accuracy.mean_ground_truth_segments();
-  const LifetimeSummary life = evaluator->lifetimes().summary();
-  out["ids"] = life.count;
-  out["lifetime_mean_ms"] = life.mean_ms;
-  out["lifetime_max_ms"] = life.max_ms;
-  const TrackingSummary tracking = evaluator->tracking().summary();
-  out["idf1"] = tracking.idf1;
-  out["id_switches"] = tracking.id_switches;
-  // None where no pair had a velocity (rows carry none), as the JSON's null.
-  const auto defined = [](double value) { return std::isnan(value) ? py::object(py::none()) : py::object(py::float_(value)); };
-  out["vel_err_med"] = defined(tracking.velocity_error_median);
-  out["vel_rel_med"] = defined(tracking.velocity_relative_median);
-  out["ids_per_line"] = tracking.ids_per_line;
-  out["coverage"] = tracking.coverage;
-  out["steps_without_prediction"] = evaluator->coverage().steps_without_prediction;
-  return out;
+  // evldt-eval's figures under its JSON keys (a run of its --json without the run's own fields).
+  return py::module_::import("json").attr("loads")(evaluation_json(make_evaluation_report(*evaluator)));
 }
 
 /// A built-in scene through the event simulator: its events, its ground truth every gt_period_us

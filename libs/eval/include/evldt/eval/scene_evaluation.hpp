@@ -123,6 +123,8 @@ class StreamEvaluator {
   [[nodiscard]] const VisibilitySplit* visibility_split() const {
     return visible_accuracy_ && visible_rule_.split ? &visible_rule_.split : nullptr;
   }
+  /// The speed the visible score asks of a true edge, where it is by speed (px/s).
+  [[nodiscard]] float visible_min_normal_speed() const { return visible_rule_.min_normal_speed; }
   /// Of the true pixels over all steps, those moving fast enough to be seen and those not (with
   /// score_visible_only).
   [[nodiscard]] std::uint64_t visible_truth_pixels() const { return visible_pixels_; }
