@@ -172,20 +172,11 @@ Timing time_receive(const BenchSettings& settings, SensorSize sensor, const Even
   });
 }
 
-Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
-  const Scene scene = make_scene(size_case.scene);
-  const EventBatch events = simulate(scene, settings.window_us);
-  PipelineConfig config = default_config_for(scene.sensor);
-  if (settings.filters) config.filters.chain = *settings.filters;
-  config.threads = settings.threads;
-  WorkerPool pool(settings.threads);
-  const auto n = static_cast<double>(events.size());
-  Figures f;
-  f.events = n;
-  f.scene_rate_mev_s = events.empty() ? 0 : n / static_cast<double>(events.t.back() - events.t.front() + 1);
-  f.events_mb = n * (sizeof(Timestamp) + 2 * sizeof(std::uint16_t) + sizeof(std::int8_t)) / 1e6;
-
-  ScarfLattice lattice(scene.sensor, config.lattice.block_size, config.lattice.alpha);
+/// Storing events in the lattice, from the batch's columns and from an array of structs.
+void measure_storage(const EventBatch& events, const PipelineConfig& config, const BenchSettings& settings, Figures& f) {
+  const SensorSize sensor = config.lattice.sensor;
+  const double n = f.events;
+  ScarfLattice lattice(sensor, config.lattice.block_size, config.lattice.alpha);
   f.lattice_mb = static_cast<double>(lattice.memory_bytes()) / 1e6;
   f.storage = per_item(time_op(settings, [&] { lattice.insert(events); }), n);
   std::vector<Event> structs(events.size());
@@ -194,19 +185,11 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
                              for (const Event& e : structs) lattice.insert(e.x, e.y);
                            }),
                            n);
-  structs = {};
-  f.receive = per_item(time_receive(settings, scene.sensor, events), n);
+}
 
-  // The passes run on the state at the end of the window; the whole-line steps on its output steps.
-  DeterministicPipeline busy(config);
-  std::vector<std::pair<Timestamp, std::vector<TrackedLine>>> output_steps;
-  busy.set_output(10000, [&](const OutputStep& step) {
-    output_steps.emplace_back(step.t, std::vector<TrackedLine>(step.segments.lines().begin(), step.segments.lines().end()));
-  });
-  busy.process(events);
-  const ScarfLattice& state = busy.lattice();
-  for (int block = 0; block < state.geometry().block_count(); ++block) f.active_points += state.active_count(block);
-
+/// A detection pass with every block free, on the lattice at the window's end.
+void measure_detection(const ScarfLattice& state, const PipelineConfig& config, WorkerPool& pool, const BenchSettings& settings,
+                       Figures& f) {
   LineMap detected(state.geometry());
   f.detect = time_op(settings, [&] {
     // A fresh detector with every block free: the most work a pass can have (a detector skips the
@@ -215,7 +198,12 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
     detected.clear();
     f.lines_created = detector.detect(state, detected, 0);
   });
+}
 
+/// A tracking pass over the lines at the window's end, every line scored.
+void measure_tracking(const DeterministicPipeline& busy, WorkerPool& pool, const BenchSettings& settings, Figures& f) {
+  const ScarfLattice& state = busy.lattice();
+  const PipelineConfig& config = busy.config();
   LineTracker tracker(state.geometry(), config.score, config.track, &pool);
   LineMap start = busy.lines();
   // Every line scored: the most work a pass can have (a pass reuses the score of a line settled on
@@ -229,7 +217,11 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
     tracker.track(state, tracked, 0);
   });
   f.track = {track_and_copy.median - copy.median, track_and_copy.min - copy.median, track_and_copy.max - copy.median};
+}
 
+/// The whole-line steps over the window's output steps, from an empty state.
+void measure_whole_lines(const std::vector<std::pair<Timestamp, std::vector<TrackedLine>>>& output_steps,
+                         const ScarfLattice& state, const PipelineConfig& config, const BenchSettings& settings, Figures& f) {
   BenchSettings replays = settings;
   replays.min_time_s = 0;  // a replay of every step is long enough
   f.whole = per_item(time_op(replays, [&] {
@@ -240,11 +232,17 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
                        f.whole_lines = static_cast<double>(whole.lines().size());
                      }),
                      static_cast<double>(std::max<std::size_t>(output_steps.size(), 1)));
+}
 
+/// The lattice copies of the real-time loops.
+void measure_snapshots(const EventBatch& events, const ScarfLattice& state, const PipelineConfig& config,
+                       const BenchSettings& settings, Figures& f) {
+  const SensorSize sensor = config.lattice.sensor;
+  const double n = f.events;
   // The snapshot of a real-time loop: in full (a new source), and after 1 ms of events (only the
   // blocks they changed).
-  ScarfLattice view(scene.sensor, config.lattice.block_size, config.lattice.alpha);
-  ScarfLattice live(scene.sensor, config.lattice.block_size, config.lattice.alpha);
+  ScarfLattice view(sensor, config.lattice.block_size, config.lattice.alpha);
+  ScarfLattice live(sensor, config.lattice.block_size, config.lattice.alpha);
   live.insert(events);
   f.snapshot = time_op(settings, [&] {
     view.copy_state_from(state);
@@ -270,13 +268,13 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
     update_seconds.push_back(total / static_cast<double>(updates));
   }
   f.snapshot_1ms = median_timing(std::move(update_seconds));
+}
 
-  BenchSettings once = settings;
-  once.min_time_s = 0;  // a pass over the whole window is long enough
-  // Filters and pipelines take the events in the batches a service receives: one batch of the
-  // whole window would time the streaming of a filtered copy as large (with its page faults in a
-  // new pipeline), which no service makes.
-  const std::vector<EventBatch> messages = as_messages(events);
+/// What a batch goes through before storage: the noise filters, and rectification.
+void measure_intake(const std::vector<EventBatch>& messages, const PipelineConfig& config, const BenchSettings& settings,
+                    Figures& f) {
+  const SensorSize sensor = config.lattice.sensor;
+  const double n = f.events;
   // A service builds its chain (and its zeroed per-pixel table) once, at start: that is timed apart
   // from the filtering, each repeat on a chain built just before it.
   std::vector<double> setup_seconds, filter_seconds;
@@ -292,24 +290,30 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   }
   f.filters_setup = median_timing(setup_seconds);
   f.filters = per_item(median_timing(filter_seconds), n);
-  {
-    // Rectification of a calibrated camera: a barrel lens as strong as the DAVIS240C's, scaled to
-    // the sensor (the table is made once, at start; each event costs a lookup).
-    CameraModel lens;
-    lens.fx = lens.fy = 0.83 * scene.sensor.width;
-    lens.cx = 0.5 * scene.sensor.width - 0.5;
-    lens.cy = 0.5 * scene.sensor.height - 0.5;
-    lens.distortion = CameraModel::Distortion::RadialTangential;
-    lens.coefficients = {-0.35, 0.15, 0.0, 0.0, 0.0};
-    PipelineConfig rectify_only = config;
-    rectify_only.filters.chain.clear();
-    rectify_only.rectification = rectification_table(lens, scene.sensor);
-    f.rectify = per_item(time_op(settings, [&] {
-                           EventIntake intake(rectify_only);
-                           for (const EventBatch& message : messages) intake.prepare(message);
-                         }),
-                         n);
-  }
+  // Rectification of a calibrated camera: a barrel lens as strong as the DAVIS240C's, scaled to
+  // the sensor (the table is made once, at start; each event costs a lookup).
+  CameraModel lens;
+  lens.fx = lens.fy = 0.83 * sensor.width;
+  lens.cx = 0.5 * sensor.width - 0.5;
+  lens.cy = 0.5 * sensor.height - 0.5;
+  lens.distortion = CameraModel::Distortion::RadialTangential;
+  lens.coefficients = {-0.35, 0.15, 0.0, 0.0, 0.0};
+  PipelineConfig rectify_only = config;
+  rectify_only.filters.chain.clear();
+  rectify_only.rectification = rectification_table(lens, sensor);
+  f.rectify = per_item(time_op(settings, [&] {
+                         EventIntake intake(rectify_only);
+                         for (const EventBatch& message : messages) intake.prepare(message);
+                       }),
+                       n);
+}
+
+/// The whole deterministic pipeline, with and without the noise filters, from an empty state.
+void measure_pipeline(const std::vector<EventBatch>& messages, const PipelineConfig& config, const BenchSettings& settings,
+                      Figures& f) {
+  BenchSettings once = settings;
+  once.min_time_s = 0;  // a pass over the whole window is long enough
+  const double n = f.events;
   const auto run_pipeline = [&](const PipelineConfig& pipeline_config) {
     DeterministicPipeline pipeline(pipeline_config);
     for (const EventBatch& message : messages) pipeline.process(message);
@@ -318,6 +322,44 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   PipelineConfig unfiltered = config;
   unfiltered.filters.chain.clear();
   f.pipeline_unfiltered = per_item(time_op(once, [&] { run_pipeline(unfiltered); }), n);
+}
+
+Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
+  const Scene scene = make_scene(size_case.scene);
+  const EventBatch events = simulate(scene, settings.window_us);
+  PipelineConfig config = default_config_for(scene.sensor);
+  if (settings.filters) config.filters.chain = *settings.filters;
+  config.threads = settings.threads;
+  WorkerPool pool(settings.threads);
+  const auto n = static_cast<double>(events.size());
+  Figures f;
+  f.events = n;
+  f.scene_rate_mev_s = events.empty() ? 0 : n / static_cast<double>(events.t.back() - events.t.front() + 1);
+  f.events_mb = n * (sizeof(Timestamp) + 2 * sizeof(std::uint16_t) + sizeof(std::int8_t)) / 1e6;
+
+  measure_storage(events, config, settings, f);
+  f.receive = per_item(time_receive(settings, scene.sensor, events), n);
+
+  // The passes run on the state at the end of the window; the whole-line steps on its output steps.
+  DeterministicPipeline busy(config);
+  std::vector<std::pair<Timestamp, std::vector<TrackedLine>>> output_steps;
+  busy.set_output(10000, [&](const OutputStep& step) {
+    output_steps.emplace_back(step.t, std::vector<TrackedLine>(step.segments.lines().begin(), step.segments.lines().end()));
+  });
+  busy.process(events);
+  const ScarfLattice& state = busy.lattice();
+  for (int block = 0; block < state.geometry().block_count(); ++block) f.active_points += state.active_count(block);
+  measure_detection(state, config, pool, settings, f);
+  measure_tracking(busy, pool, settings, f);
+  measure_whole_lines(output_steps, state, config, settings, f);
+  measure_snapshots(events, state, config, settings, f);
+
+  // Filters and pipelines take the events in the batches a service receives: one batch of the
+  // whole window would time the streaming of a filtered copy as large (with its page faults in a
+  // new pipeline), which no service makes.
+  const std::vector<EventBatch> messages = as_messages(events);
+  measure_intake(messages, config, settings, f);
+  measure_pipeline(messages, config, settings, f);
   f.peak_rss_mb = peak_rss_mb();
   return f;
 }

@@ -383,129 +383,122 @@ void write_edge_recall(const std::vector<Report>& reports, const std::filesystem
   spdlog::info("wrote the recall of every true edge at every step to {}", path.string());
 }
 
-int run(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim) {
-  std::vector<Report> reports;
-  std::optional<StreamEvaluator> last;
-  if (!options.whole_lines.empty() && options.segments.empty()) {
-    spdlog::error("--whole-lines is scored against the segments of the same run: give --segments too");
+// No ground truth, --whole-lines: their support by the segments of the same run alone (a real recording).
+int score_support_only(const Options& options) {
+  const SupportSummary support = file_support(read_segments(options), read_segment_csv(options.whole_lines));
+  print_support(options.whole_lines.filename().string(), support);
+  if (!options.json.empty()) {
+    std::ofstream out(options.json);
+    JsonWriter json(out);
+    json.begin_object();
+    write_support_json(json, support);
+    json.end_object();
+    out << "\n";
+    if (!json.done() || !out) throw std::runtime_error("error writing " + options.json.string());
+  }
+  return 0;
+}
+
+// --segments: a file of predicted segments against the ground truth.
+int score_segment_file(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim,
+                       std::vector<Report>& reports) {
+  if (options.frames_gt.empty() && options.ground_truth.empty() == !sim.scene_selected()) {
+    spdlog::error("with --segments give the ground truth: --ground-truth FILE, --scene NAME or --frames-gt SOURCE");
     return 1;
   }
-  if (!options.whole_lines.empty() && options.ground_truth.empty() && options.frames_gt.empty() && !sim.scene_selected()) {
-    // No ground truth: the support alone (a real recording).
-    const SupportSummary support = file_support(read_segments(options), read_segment_csv(options.whole_lines));
-    print_support(options.whole_lines.filename().string(), support);
-    if (!options.json.empty()) {
-      std::ofstream out(options.json);
-      JsonWriter json(out);
-      json.begin_object();
-      write_support_json(json, support);
-      json.end_object();
-      out << "\n";
-      if (!json.done() || !out) throw std::runtime_error("error writing " + options.json.string());
-    }
-    return 0;
+  std::optional<SensorSize> sensor = sim.scene_selected() ? std::optional<SensorSize>(sim.scene().sensor) : pipeline_options.sensor();
+  if (!sensor && !options.frames_gt.empty()) {
+    sensor = frames_sensor_size(options.frames_gt, options.frames_topic);
+    spdlog::info("sensor {}x{}: the size of the frames of {}", sensor->width, sensor->height, options.frames_gt.string());
   }
-  if ((!options.edge_recall.empty() || !options.edge_recall_png.empty()) && !options.segments.empty()) {
-    spdlog::error("--edge-recall scores the pipeline's run on --scene (without --segments)");
+  if (!sensor) {
+    spdlog::error("give the sensor size (--width/--height or --config) for file-only evaluation without --frames-gt");
     return 1;
   }
-  if (options.visible_only && !options.frames_gt.empty() && options.segments.empty()) {
-    spdlog::error("--visible-only with --frames-gt scores a recording's --segments: LSD's lines are seen by its events");
+  std::vector<SegmentRow> rows = read_segments(options);
+  std::optional<SupportSummary> support;
+  std::vector<SegmentRow> whole_line_rows;
+  if (!options.whole_lines.empty()) {
+    whole_line_rows = read_segment_csv(options.whole_lines);
+    support = file_support(rows, whole_line_rows);
+  }
+  const std::vector<SegmentRow> overlay_rows = options.overlay.empty() ? std::vector<SegmentRow>() : rows;
+  const StreamEvaluator scored = evaluate_files(options, std::move(rows), *sensor, sim);
+  if (!options.overlay.empty()) write_overlay_pictures(options, scored, overlay_rows, whole_line_rows, *sensor);
+  reports.push_back(make_report(scored));
+  reports.back().label = options.label.empty() ? options.segments.filename().string() : options.label;
+  reports.back().support = support;
+  write_run_plots(options, scored, reports.back(), false);
+  const StepCoverage& c = scored.coverage();
+  spdlog::info("{} ground-truth steps scored, {} of them with no prediction within {:.1f} ms; {} predicted steps, {} "
+               "scored, {} outside the ground truth's time range (not scored)",
+               c.ground_truth_steps, c.steps_without_prediction, static_cast<double>(scored.hold_us()) * 1e-3,
+               c.predicted_steps, c.predicted_steps_scored, c.predicted_steps_outside);
+  return 0;
+}
+
+// --scene without --segments: the pipeline on the scene, once per threshold, its segments and whole lines.
+int score_scene_runs(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim,
+                     std::vector<Report>& reports) {
+  if (!sim.scene_selected()) {
+    spdlog::error("give --segments FILE, or --scene NAME to run the pipeline on a built-in scene");
     return 1;
   }
-  if (!options.overlay.empty() && (options.segments.empty() || options.frames_gt.empty())) {
-    spdlog::error("--overlay draws the frames of --frames-gt with the lines of --segments: give both");
+  if ((!options.edge_recall.empty() || !options.edge_recall_png.empty()) && !options.frames_gt.empty()) {
+    spdlog::error("--edge-recall needs the scene's exact edges: LSD's lines (--frames-gt) have no ids that last");
     return 1;
   }
-  if (!options.segments.empty()) {
-    if (options.frames_gt.empty() && options.ground_truth.empty() == !sim.scene_selected()) {
-      spdlog::error("with --segments give the ground truth: --ground-truth FILE, --scene NAME or --frames-gt SOURCE");
-      return 1;
+  const Scene scene = sim.scene();
+  const PipelineConfig base = pipeline_options.resolve(scene.sensor);
+  std::vector<float> thresholds = options.pr_thresholds;
+  if (thresholds.empty()) thresholds.push_back(base.score.fit_threshold);
+  const GroundTruthSteps truth = ground_truth_steps(options, sim, scene.sensor);
+  const Timestamp hold_us = StreamEvaluator::hold_for_period(options.step_us);
+  for (const float threshold : thresholds) {
+    PipelineConfig config = base;
+    config.score.fit_threshold = threshold;
+    const auto started = std::chrono::steady_clock::now();
+    StreamEvaluator segments(scene.sensor, options.tolerances, truth, hold_us);
+    StreamEvaluator whole(scene.sensor, options.tolerances, truth, hold_us);
+    if (!options.edge_recall.empty() || !options.edge_recall_png.empty()) {
+      const Timestamp middle = truth.times.empty() ? 0 : truth.times[truth.times.size() / 2];
+      segments.keep_edge_recall(middle);
+      whole.keep_edge_recall(middle);
     }
-    std::optional<SensorSize> sensor = sim.scene_selected() ? std::optional<SensorSize>(sim.scene().sensor) : pipeline_options.sensor();
-    if (!sensor && !options.frames_gt.empty()) {
-      sensor = frames_sensor_size(options.frames_gt, options.frames_topic);
-      spdlog::info("sensor {}x{}: the size of the frames of {}", sensor->width, sensor->height, options.frames_gt.string());
+    if (options.visible_only) {
+      segments.score_visible_only(VisibleOnly::by_speed(options.min_normal_speed));
+      whole.score_visible_only(VisibleOnly::by_speed(options.min_normal_speed));
     }
-    if (!sensor) {
-      spdlog::error("give the sensor size (--width/--height or --config) for file-only evaluation without --frames-gt");
-      return 1;
-    }
-    std::vector<SegmentRow> rows = read_segments(options);
-    std::optional<SupportSummary> support;
-    std::vector<SegmentRow> whole_line_rows;
-    if (!options.whole_lines.empty()) {
-      whole_line_rows = read_segment_csv(options.whole_lines);
-      support = file_support(rows, whole_line_rows);
-    }
-    const std::vector<SegmentRow> overlay_rows = options.overlay.empty() ? std::vector<SegmentRow>() : rows;
-    last.emplace(evaluate_files(options, std::move(rows), *sensor, sim));
-    if (!options.overlay.empty()) write_overlay_pictures(options, *last, overlay_rows, whole_line_rows, *sensor);
-    reports.push_back(make_report(*last));
-    reports.back().label = options.label.empty() ? options.segments.filename().string() : options.label;
-    reports.back().support = support;
-    write_run_plots(options, *last, reports.back(), false);
-    const StepCoverage& c = last->coverage();
-    spdlog::info("{} ground-truth steps scored, {} of them with no prediction within {:.1f} ms; {} predicted steps, {} "
-                 "scored, {} outside the ground truth's time range (not scored)",
-                 c.ground_truth_steps, c.steps_without_prediction, static_cast<double>(last->hold_us()) * 1e-3,
-                 c.predicted_steps, c.predicted_steps_scored, c.predicted_steps_outside);
-  } else {
-    if (!sim.scene_selected()) {
-      spdlog::error("give --segments FILE, or --scene NAME to run the pipeline on a built-in scene");
-      return 1;
-    }
-    if ((!options.edge_recall.empty() || !options.edge_recall_png.empty()) && !options.frames_gt.empty()) {
-      spdlog::error("--edge-recall needs the scene's exact edges: LSD's lines (--frames-gt) have no ids that last");
-      return 1;
-    }
-    const Scene scene = sim.scene();
-    const PipelineConfig base = pipeline_options.resolve(scene.sensor);
-    std::vector<float> thresholds = options.pr_thresholds;
-    if (thresholds.empty()) thresholds.push_back(base.score.fit_threshold);
-    const GroundTruthSteps truth = ground_truth_steps(options, sim, scene.sensor);
-    const Timestamp hold_us = StreamEvaluator::hold_for_period(options.step_us);
-    for (const float threshold : thresholds) {
-      PipelineConfig config = base;
-      config.score.fit_threshold = threshold;
-      const auto started = std::chrono::steady_clock::now();
-      last.emplace(scene.sensor, options.tolerances, truth, hold_us);
-      StreamEvaluator whole(scene.sensor, options.tolerances, truth, hold_us);
-      if (!options.edge_recall.empty() || !options.edge_recall_png.empty()) {
-        const Timestamp middle = truth.times.empty() ? 0 : truth.times[truth.times.size() / 2];
-        last->keep_edge_recall(middle);
-        whole.keep_edge_recall(middle);
-      }
-      if (options.visible_only) {
-        last->score_visible_only(VisibleOnly::by_speed(options.min_normal_speed));
-        whole.score_visible_only(VisibleOnly::by_speed(options.min_normal_speed));
-      }
-      const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, *last, &whole, options.thin);
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-      spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, result.events, wall);
-      for (const auto& [evaluator, label] : {std::pair<const StreamEvaluator*, std::string>{&*last, scene.name},
-                                             {&whole, scene.name + " whole"}}) {
-        Report r = make_report(*evaluator);
-        r.label = label;
-        r.whole_lines = evaluator == &whole;
-        r.threshold = threshold;
-        r.events = result.events;
-        r.scene_seconds = result.scene_seconds;
-        r.wall_seconds = wall;
-        if (r.whole_lines) r.support = result.whole_line_support;
-        write_run_plots(options, *evaluator, r, thresholds.size() > 1);
-        reports.push_back(r);
-      }
-    }
-    if (!options.frames_gt.empty()) {
-      // How good the imitation is: LSD's lines on the frames, scored against the scene's exact lines.
-      const StreamEvaluator lsd =
-          evaluate_steps_against(truth, scene_ground_truth_steps(scene, options.step_us), scene.sensor, options.tolerances);
-      Report r = make_report(lsd);
-      r.label = scene.name + " lsd/exact";
+    const SceneRunResult result = evaluate_scene(scene, sim.config(), config, options.step_us, segments, &whole, options.thin);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    spdlog::info("{} f_th={}: {} events, {:.2f} s wall", scene.name, threshold, result.events, wall);
+    for (const auto& [evaluator, label] : {std::pair<const StreamEvaluator*, std::string>{&segments, scene.name},
+                                           {&whole, scene.name + " whole"}}) {
+      Report r = make_report(*evaluator);
+      r.label = label;
+      r.whole_lines = evaluator == &whole;
+      r.threshold = threshold;
+      r.events = result.events;
+      r.scene_seconds = result.scene_seconds;
+      r.wall_seconds = wall;
+      if (r.whole_lines) r.support = result.whole_line_support;
+      write_run_plots(options, *evaluator, r, thresholds.size() > 1);
       reports.push_back(r);
     }
   }
+  if (!options.frames_gt.empty()) {
+    // How good the imitation is: LSD's lines on the frames, scored against the scene's exact lines.
+    const StreamEvaluator lsd =
+        evaluate_steps_against(truth, scene_ground_truth_steps(scene, options.step_us), scene.sensor, options.tolerances);
+    Report r = make_report(lsd);
+    r.label = scene.name + " lsd/exact";
+    reports.push_back(r);
+  }
+  return 0;
+}
+
+// Every report as the options ask: the table and its companions, then the files.
+void print_and_write(const std::vector<Report>& reports, const Options& options) {
   print_table(reports, options);
   print_switch_causes(reports);
   for (const Report& r : reports) {
@@ -521,6 +514,33 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
     write_pr_curve_png(options.pr_png, points, reports.front().label + " PR over f_th (tolerance " +
                                                    std::to_string(options.tolerances[0] * 100).substr(0, 3) + "% of diagonal)");
   }
+}
+
+int run(const Options& options, const PipelineOptions& pipeline_options, const SimulatorOptions& sim) {
+  if (!options.whole_lines.empty() && options.segments.empty()) {
+    spdlog::error("--whole-lines is scored against the segments of the same run: give --segments too");
+    return 1;
+  }
+  if (!options.whole_lines.empty() && options.ground_truth.empty() && options.frames_gt.empty() && !sim.scene_selected()) {
+    return score_support_only(options);
+  }
+  if ((!options.edge_recall.empty() || !options.edge_recall_png.empty()) && !options.segments.empty()) {
+    spdlog::error("--edge-recall scores the pipeline's run on --scene (without --segments)");
+    return 1;
+  }
+  if (options.visible_only && !options.frames_gt.empty() && options.segments.empty()) {
+    spdlog::error("--visible-only with --frames-gt scores a recording's --segments: LSD's lines are seen by its events");
+    return 1;
+  }
+  if (!options.overlay.empty() && (options.segments.empty() || options.frames_gt.empty())) {
+    spdlog::error("--overlay draws the frames of --frames-gt with the lines of --segments: give both");
+    return 1;
+  }
+  std::vector<Report> reports;
+  const int status = options.segments.empty() ? score_scene_runs(options, pipeline_options, sim, reports)
+                                              : score_segment_file(options, pipeline_options, sim, reports);
+  if (status != 0) return status;
+  print_and_write(reports, options);
   return 0;
 }
 
