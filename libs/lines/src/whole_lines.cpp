@@ -140,9 +140,9 @@ float WholeLineTracker::held_reach(Point2 from, Point2 to, float spread) const {
   return last_held;
 }
 
-std::uint64_t WholeLineTracker::previous_owner(std::uint64_t segment_id) const {
-  const auto it = std::lower_bound(owner_.begin(), owner_.end(), std::pair(segment_id, std::uint64_t{0}));
-  return it != owner_.end() && it->first == segment_id ? it->second : kNoKey;
+std::uint64_t WholeLineTracker::former_track_of(std::uint64_t segment_id) const {
+  const auto it = std::lower_bound(track_of_segment_id_.begin(), track_of_segment_id_.end(), std::pair(segment_id, std::uint64_t{0}));
+  return it != track_of_segment_id_.end() && it->first == segment_id ? it->second : kNoKey;
 }
 
 void WholeLineTracker::add_member(Cluster& cluster, std::uint32_t s, std::span<const TrackedLine> segments) {
@@ -182,7 +182,7 @@ void WholeLineTracker::add_member(Cluster& cluster, std::uint32_t s, std::span<c
   }
 }
 
-void WholeLineTracker::grow(Cluster& cluster, std::uint64_t owner, std::span<const TrackedLine> segments) {
+void WholeLineTracker::grow(Cluster& cluster, std::uint64_t former_track, std::span<const TrackedLine> segments) {
   // Candidates are segments with an end in the 3 x 3 cells around an end of a member; a cell is as
   // wide as the gap and offset allowed, so no candidate is missed.
   for (std::size_t next = cluster.first_member; next < members_.size(); ++next) {
@@ -191,7 +191,7 @@ void WholeLineTracker::grow(Cluster& cluster, std::uint64_t owner, std::span<con
       end_grid_.for_each_near(end, [&](std::uint32_t end_index) {
         const std::uint32_t k = end_index / 2;
         if (cluster_of_segment_[k] != kUnassigned) return;
-        const bool was_member = owner != kNoKey && owner_of_segment_[k] == owner;
+        const bool was_member = former_track != kNoKey && former_track_of_segment_[k] == former_track;
         const float relax = was_member ? kLooseJoin : 1.0f;
         if (fits(cluster.model, segments[k].segment, relax, relax)) add_member(cluster, k, segments);
       });
@@ -421,17 +421,29 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   event_pixels_.reset(events);
   stepped_ = true;
   last_t_ = t;
-  const auto n = static_cast<std::uint32_t>(segments.size());
+  // Association: which segments make each line, and which line keeps which id.
+  index_segments(segments);
+  const std::size_t first_new_cluster = associate(t, segments);
+  carry_tracks_over(t, first_new_cluster, segments);
+  publish(t);
+  // End geometry: the published lines' ends drawn out along the events and met at corners.
+  reach_along_events();
+  meet_at_corners();
+  events_ = nullptr;  // the caller's lattice is not kept past the step
+  event_pixels_.reset(nullptr);
+}
 
+void WholeLineTracker::index_segments(std::span<const TrackedLine> segments) {
+  const auto n = static_cast<std::uint32_t>(segments.size());
   ends_.clear();
-  owned_.clear();
-  owner_of_segment_.resize(n);
+  segments_of_former_track_.clear();
+  former_track_of_segment_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) {
     ends_.push_back(segments[i].segment.q0);
     ends_.push_back(segments[i].segment.q1);
-    const std::uint64_t owner = previous_owner(segments[i].id);
-    owner_of_segment_[i] = owner;
-    if (owner != kNoKey) owned_.emplace_back(owner, i);
+    const std::uint64_t former = former_track_of(segments[i].id);
+    former_track_of_segment_[i] = former;
+    if (former != kNoKey) segments_of_former_track_.emplace_back(former, i);
   }
   end_grid_.build(cell_size_, ends_);
   // Longest segments first, of a line's former segments and of new lines' seeds, so a line's direction
@@ -440,58 +452,27 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     const float la = segments[a].segment.length(), lb = segments[b].segment.length();
     return la != lb ? la > lb : segments[a].id < segments[b].id;
   };
-  std::sort(owned_.begin(), owned_.end(), [&](const auto& a, const auto& b) {
+  std::sort(segments_of_former_track_.begin(), segments_of_former_track_.end(), [&](const auto& a, const auto& b) {
     return a.first != b.first ? a.first < b.first : longer(a.second, b.second);
   });
   order_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) order_[i] = i;
   std::sort(order_.begin(), order_.end(), longer);
+}
 
-  cluster_of_segment_.assign(n, kUnassigned);
+std::size_t WholeLineTracker::associate(Timestamp t, std::span<const TrackedLine> segments) {
+  cluster_of_segment_.assign(segments.size(), kUnassigned);
   clusters_.clear();
   cluster_of_track_.assign(tracks_.size(), kNone);
   members_.clear();
-  // Lines tracked so far, the first published first: it wins a contested segment and keeps its id.
-  // A line takes back its former segments (take_back) and, where it has none, looks along its last
-  // geometry for a free segment (look_along); then it grows.
-  const auto follow = [&](std::size_t k, bool take_back, bool look_along) {
-    const Track& track = tracks_[k];
-    if (t - track.last_seen_us > params_.keep_id_us || cluster_of_track_[k] != kNone) return;
-    const LineModel expected = expected_model(track, t);
-    Cluster cluster;
-    cluster.model = expected;
-    cluster.first_member = members_.size();
-    auto it = std::lower_bound(owned_.begin(), owned_.end(), std::pair(track.key, std::uint32_t{0}),
-                               [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (; take_back && it != owned_.end() && it->first == track.key; ++it) {
-      // Its former segments are taken back along its last geometry until those taken back span
-      // enough to fit a direction of their own: one tilted segment taken back first (the longest,
-      // at a corner) would else steer the line off its edge and leave the rest, and with it the
-      // edge's id, to a younger line.
-      const bool own_fit = members_.size() > cluster.first_member &&
-                           cluster.model.t_max - cluster.model.t_min >= kOwnFitRatio * block_size_;
-      if (cluster_of_segment_[it->second] == kUnassigned &&
-          fits(own_fit ? cluster.model : expected, segments[it->second].segment, kLooseJoin, kLooseJoin)) {
-        add_member(cluster, it->second, segments);
-      }
-    }
-    if (members_.size() == cluster.first_member) {
-      const std::size_t found = look_along ? first_fit_along(expected, segments) : kNone;
-      if (found == kNone) return;  // waits, under its last geometry
-      add_member(cluster, static_cast<std::uint32_t>(found), segments);
-    }
-    grow(cluster, track.key, segments);
-    cluster_of_track_[k] = clusters_.size();
-    clusters_.push_back(cluster);
-  };
   // Published lines that take back segments go before those that wait: a waiting line looks for
   // its edge among the segments no published line took, so its old geometry does not take up
   // another published line's edge (and id with it). Lines not yet published come last.
   const auto published_count = static_cast<std::size_t>(
       std::find_if(tracks_.begin(), tracks_.end(), [](const Track& track) { return track.id == 0; }) - tracks_.begin());
-  for (std::size_t k = 0; k < published_count; ++k) follow(k, true, false);
-  for (std::size_t k = 0; k < published_count; ++k) follow(k, false, true);
-  for (std::size_t k = published_count; k < tracks_.size(); ++k) follow(k, true, true);
+  for (std::size_t k = 0; k < published_count; ++k) follow_track(k, t, true, false, segments);
+  for (std::size_t k = 0; k < published_count; ++k) follow_track(k, t, false, true, segments);
+  for (std::size_t k = published_count; k < tracks_.size(); ++k) follow_track(k, t, true, true, segments);
   // New lines from the segments left.
   const std::size_t first_new_cluster = clusters_.size();
   for (const std::uint32_t seed : order_) {
@@ -501,19 +482,55 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     cluster.first_member = members_.size();
     cluster.model.direction = (s.q1 - s.q0).normalized();
     add_member(cluster, seed, segments);
-    grow(cluster, owner_of_segment_[seed], segments);
+    grow(cluster, former_track_of_segment_[seed], segments);
     clusters_.push_back(cluster);
   }
+  return first_new_cluster;
+}
 
-  const auto members_of = [&](std::size_t c) {
-    const std::size_t end = c + 1 < clusters_.size() ? clusters_[c + 1].first_member : members_.size();
-    return static_cast<std::uint32_t>(end - clusters_[c].first_member);
-  };
+void WholeLineTracker::follow_track(std::size_t k, Timestamp t, bool take_back, bool look_along,
+                                    std::span<const TrackedLine> segments) {
+  const Track& track = tracks_[k];
+  if (t - track.last_seen_us > params_.keep_id_us || cluster_of_track_[k] != kNone) return;
+  const LineModel expected = expected_model(track, t);
+  Cluster cluster;
+  cluster.model = expected;
+  cluster.first_member = members_.size();
+  auto it = std::lower_bound(segments_of_former_track_.begin(), segments_of_former_track_.end(),
+                             std::pair(track.key, std::uint32_t{0}), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (; take_back && it != segments_of_former_track_.end() && it->first == track.key; ++it) {
+    // Its former segments are taken back along its last geometry until those taken back span
+    // enough to fit a direction of their own: one tilted segment taken back first (the longest,
+    // at a corner) would else steer the line off its edge and leave the rest, and with it the
+    // edge's id, to a younger line.
+    const bool own_fit = members_.size() > cluster.first_member &&
+                         cluster.model.t_max - cluster.model.t_min >= kOwnFitRatio * block_size_;
+    if (cluster_of_segment_[it->second] == kUnassigned &&
+        fits(own_fit ? cluster.model : expected, segments[it->second].segment, kLooseJoin, kLooseJoin)) {
+      add_member(cluster, it->second, segments);
+    }
+  }
+  if (members_.size() == cluster.first_member) {
+    const std::size_t found = look_along ? first_fit_along(expected, segments) : kNone;
+    if (found == kNone) return;  // waits, under its last geometry
+    add_member(cluster, static_cast<std::uint32_t>(found), segments);
+  }
+  grow(cluster, track.key, segments);
+  cluster_of_track_[k] = clusters_.size();
+  clusters_.push_back(cluster);
+}
+
+std::uint32_t WholeLineTracker::members_of(std::size_t c) const {
+  const std::size_t end = c + 1 < clusters_.size() ? clusters_[c + 1].first_member : members_.size();
+  return static_cast<std::uint32_t>(end - clusters_[c].first_member);
+}
+
+void WholeLineTracker::carry_tracks_over(Timestamp t, std::size_t first_new_cluster, std::span<const TrackedLine> segments) {
   next_tracks_.clear();
-  next_owner_.clear();
+  next_track_of_segment_id_.clear();
   const auto take_ownership = [&](std::size_t c, std::uint64_t key) {
     const std::size_t first = clusters_[c].first_member;
-    for (std::size_t m = first; m < first + members_of(c); ++m) next_owner_.emplace_back(segments[members_[m]].id, key);
+    for (std::size_t m = first; m < first + members_of(c); ++m) next_track_of_segment_id_.emplace_back(segments[members_[m]].id, key);
   };
   for (std::size_t k = 0; k < tracks_.size(); ++k) {
     Track& track = tracks_[k];
@@ -536,9 +553,11 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
     next_tracks_.push_back(track);
   }
   tracks_.swap(next_tracks_);
-  std::sort(next_owner_.begin(), next_owner_.end());
-  owner_.swap(next_owner_);
+  std::sort(next_track_of_segment_id_.begin(), next_track_of_segment_id_.end());
+  track_of_segment_id_.swap(next_track_of_segment_id_);
+}
 
+void WholeLineTracker::publish(Timestamp t) {
   published_.clear();
   const float min_length = params_.min_length_ratio * block_size_;
   for (Track& track : tracks_) {
@@ -560,10 +579,6 @@ void WholeLineTracker::update(Timestamp t, std::span<const TrackedLine> segments
   std::sort(tracks_.begin(), tracks_.end(), [](const Track& a, const Track& b) {
     return std::tuple(a.id == 0, a.id, a.key) < std::tuple(b.id == 0, b.id, b.key);
   });
-  reach_along_events();
-  meet_at_corners();
-  events_ = nullptr;  // the caller's lattice is not kept past the step
-  event_pixels_.reset(nullptr);
 }
 
 }  // namespace evldt

@@ -87,13 +87,29 @@ class WholeLineTracker {
   /// over runs of up to b without one; all of it once what is left after such a pixel is at most b
   /// long; 0 if there is none. All of it without a lattice.
   [[nodiscard]] float held_reach(Point2 from, Point2 to, float spread) const;
-  /// The track key a segment belonged to at the last step, or 0.
-  [[nodiscard]] std::uint64_t previous_owner(std::uint64_t segment_id) const;
+  /// The key of the track a segment (by id) belonged to at the last step, or 0.
+  [[nodiscard]] std::uint64_t former_track_of(std::uint64_t segment_id) const;
+  /// This step's segments indexed: their ends in a grid, the track each belonged to, longest first.
+  void index_segments(std::span<const TrackedLine> segments);
+  /// Each track, the first published first, takes back its former segments or finds its edge along
+  /// where it is expected, and grows; then new lines grow from the segments left. Returns the first
+  /// new line's cluster.
+  std::size_t associate(Timestamp t, std::span<const TrackedLine> segments);
+  /// Track k's cluster this step: its former segments taken back (take_back), else a free one found
+  /// along its expected geometry (look_along), then grown; none leaves it waiting.
+  void follow_track(std::size_t k, Timestamp t, bool take_back, bool look_along, std::span<const TrackedLine> segments);
+  [[nodiscard]] std::uint32_t members_of(std::size_t cluster) const;
+  /// The tracks of the next step (followed ones moved to their clusters, waiting ones kept, ended
+  /// ones dropped, new ones) and the track of each segment id.
+  void carry_tracks_over(Timestamp t, std::size_t first_new_cluster, std::span<const TrackedLine> segments);
+  /// The lines published at this step (an id for each new one long enough and not shadowed), and
+  /// the tracks in publishing order.
+  void publish(Timestamp t);
   /// Adds segment `s` as a member of the last cluster and refits its direction and extent.
   void add_member(Cluster& cluster, std::uint32_t s, std::span<const TrackedLine> segments);
   /// Adds to the last cluster every free segment that fits it, searching the grid cells around its
-  /// members' ends. owner: the key whose former segments fit loosely (0: none).
-  void grow(Cluster& cluster, std::uint64_t owner, std::span<const TrackedLine> segments);
+  /// members' ends. former_track: the key whose former segments fit loosely (0: none).
+  void grow(Cluster& cluster, std::uint64_t former_track, std::span<const TrackedLine> segments);
   /// The first free segment (in grid order) that fits `line` within the loose angle, twice the offset
   /// bound and the gap bound (fits()), searched along its extent, or npos.
   [[nodiscard]] std::size_t first_fit_along(const LineModel& line, std::span<const TrackedLine> segments) const;
@@ -141,13 +157,13 @@ class WholeLineTracker {
   PointGrid end_grid_;       ///< of the segments' ends
   PointGrid corner_grid_;    ///< of the published lines' ends
   std::vector<std::uint32_t> order_, members_, cluster_of_segment_;
-  std::vector<std::uint64_t> owner_of_segment_;  ///< previous_owner() of each segment of this step
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> owned_;  ///< (former owner key, segment), by key then length
+  std::vector<std::uint64_t> former_track_of_segment_;  ///< former_track_of() each segment (by index) of this step
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> segments_of_former_track_;  ///< (former track key, segment index), by key then length
   std::vector<Cluster> clusters_;
   std::vector<std::size_t> cluster_of_track_;  ///< index into clusters_ of each of tracks_, or npos
   std::vector<Track> next_tracks_;
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> owner_;  ///< (segment id, track key) of the last step, sorted
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> next_owner_;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> track_of_segment_id_;  ///< (segment id, track key) of the last step, sorted
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> next_track_of_segment_id_;
   struct Corner {
     float cost = 0;  ///< the two ends' distances to the corner
     std::uint32_t end_a = 0, end_b = 0;
