@@ -54,112 +54,146 @@ CameraNode::CameraNode(lcm::LCM& lcm, CameraNodeOptions options, std::int64_t ep
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
 }
 
-CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomic<bool>& stop) {
-  std::unique_ptr<EventSource> source = open_source();
-  CameraSummary summary;
-  summary.source = source->name();
-  const std::optional<SensorSize> sensor = options_.sensor ? options_.sensor : source->geometry();
-  if (!sensor) {
-    throw std::runtime_error(source->name() + " has no sensor size in its header: pass --width and --height");
+/// One run of the node over a source (and its loops): the state run() keeps from read to read.
+class CameraNode::Run {
+ public:
+  Run(CameraNode& node, const SourceFactory& open_source, const std::atomic<bool>& stop)
+      : node_(node), options_(node.options_), open_source_(open_source), stop_(stop), source_(open_source()),
+        validator_(sensor_of(*source_, options_), options_.time_slack_us),
+        batcher_(options_.batch_us, options_.max_batch),
+        live_(source_->live()),
+        pacer_(live_ ? 0.0 : options_.speed) {
+    if (live_ && options_.loop) throw std::invalid_argument("--loop replays a recording; " + source_->name() + " cannot be read again");
+    summary_.source = source_->name();
+    summary_.sensor = sensor_of(*source_, options_);
+    summary_.live = live_;
+    node_.sensor_lag_ = SensorLag();
+    node_.first_published_t_.reset();
+    spdlog::info("publishing {} ({}x{}) on {} {}", source_->name(), summary_.sensor.width, summary_.sensor.height,
+                 node_.channel_,
+                 live_                ? std::string("as it comes")
+                 : options_.speed > 0 ? fmt::format("at {}x real time", options_.speed)
+                                      : std::string("at full speed"));
   }
-  if (!sensor->valid()) {
-    throw std::runtime_error(sensor->range_error());
-  }
-  summary.sensor = *sensor;
-  EventValidator validator(*sensor, options_.time_slack_us);
-  EventBatcher batcher(options_.batch_us, options_.max_batch);
-  // A live source's events go out as they come: not paced, and each read's last batch at once, not
-  // held until an event of a later window arrives.
-  const bool live = source->live();
-  summary.live = live;
-  sensor_lag_ = SensorLag();
-  std::uint64_t clock_resets_seen = 0;
-  if (live && options_.loop) throw std::invalid_argument("--loop replays a recording; " + source->name() + " cannot be read again");
-  Pacer pacer(live ? 0.0 : options_.speed);
-  EventBatch chunk, batch;
-  first_published_t_.reset();
-  Timestamp offset = 0;         // added to event times so every loop continues forward in time
-  bool rebase = false;
-  const auto started = Clock::now();
-  auto last_progress = started;
-  spdlog::info("publishing {} ({}x{}) on {} {}", source->name(), sensor->width, sensor->height, channel_,
-               live                 ? std::string("as it comes")
-               : options_.speed > 0 ? fmt::format("at {}x real time", options_.speed)
-                                    : std::string("at full speed"));
 
-  auto last_stats = started;
-  std::uint64_t published_at_last_stats = 0;
-  const auto stats = [&](bool final) {
-    const auto now = Clock::now();
-    const double period_s = std::chrono::duration<double>(now - last_stats).count();
-    if (options_.stats_hz <= 0 || (!final && period_s < 1.0 / options_.stats_hz)) return;
-    DecodeCounts decoded = summary.decoded;
-    if (!final) decoded += source->decode_counts();  // at the end, summary.decoded holds them all
-    summary.reconnects = source->reconnects();
-    publish_stats(summary, decoded, final ? summary.drops : validator.drops(), period_s,
-                  summary.events_published - published_at_last_stats);
-    last_stats = now;
-    published_at_last_stats = summary.events_published;
-  };
-  const auto publish_ready = [&](bool flush) {
-    while (!stop.load() && batcher.pop(batch, flush)) {
-      summary.max_lag_s = std::max(summary.max_lag_s, pacer.wait_until(batch.t.back(), stop));
-      publish(batch, summary);
-      if (live) {
-        if (validator.drops().clock_resets != clock_resets_seen) {  // the camera restarted: its clock began afresh
-          clock_resets_seen = validator.drops().clock_resets;
-          sensor_lag_.restart();
+  CameraSummary run() {
+    try {
+      while (!stop_.load() && read_and_publish()) {
+      }
+    } catch (const FormatError& error) {
+      spdlog::error("{} (every event before it was published)", error.what());
+      summary_.input_error = error.what();
+    }
+    publish_ready(true);
+    summary_.decoded += source_->decode_counts();
+    summary_.drops = validator_.drops();
+    summary_.skipped_gaps = pacer_.skipped_gaps();
+    summary_.sensor_lag = node_.sensor_lag_.run_summary();
+    summary_.sensor_clock_offset_s = node_.sensor_lag_.clock_offset_s();
+    summary_.reconnects = source_->reconnects();
+    summary_.wall_seconds = std::chrono::duration<double>(Clock::now() - started_).count();
+    stats(true);
+    return summary_;
+  }
+
+ private:
+  /// The sensor size the options give, else the source's header's; throws without one.
+  static SensorSize sensor_of(const EventSource& source, const CameraNodeOptions& options) {
+    const std::optional<SensorSize> sensor = options.sensor ? options.sensor : source.geometry();
+    if (!sensor) throw std::runtime_error(source.name() + " has no sensor size in its header: pass --width and --height");
+    if (!sensor->valid()) throw std::runtime_error(sensor->range_error());
+    return *sensor;
+  }
+
+  /// Reads a chunk of the source and publishes the batches it completes; false once the source
+  /// ended (and is not looped).
+  bool read_and_publish() {
+    if (!source_->read(chunk_)) {
+      if (!options_.loop) return false;
+      summary_.decoded += source_->decode_counts();
+      source_ = open_source_();
+      ++summary_.loops;
+      rebase_ = true;
+      return true;
+    }
+    summary_.events_read += chunk_.size();
+    if (chunk_.empty()) return true;
+    if (rebase_) {  // a loop continues forward in time
+      offset_ = validator_.newest_time() + options_.batch_us - chunk_.t.front();
+      rebase_ = false;
+    }
+    if (offset_ != 0) {
+      for (Timestamp& t : chunk_.t) t += offset_;
+    }
+    validator_.filter(chunk_);
+    if (chunk_.empty()) return true;
+    batcher_.push(std::move(chunk_));  // chunk_ gets the storage of a consumed one back
+    // A live source's events go out as they come: each read's last batch at once, not held until an
+    // event of a later window arrives.
+    publish_ready(live_);
+    progress();
+    return true;
+  }
+
+  void publish_ready(bool flush) {
+    while (!stop_.load() && batcher_.pop(batch_, flush)) {
+      summary_.max_lag_s = std::max(summary_.max_lag_s, pacer_.wait_until(batch_.t.back(), stop_));
+      node_.publish(batch_, summary_);
+      if (live_) {
+        if (validator_.drops().clock_resets != clock_resets_seen_) {  // the camera restarted: its clock began afresh
+          clock_resets_seen_ = validator_.drops().clock_resets;
+          node_.sensor_lag_.restart();
         }
-        sensor_lag_.published(batch.t.back(), header_.utime);
+        node_.sensor_lag_.published(batch_.t.back(), node_.header_.utime);
       }
       stats(false);
     }
-  };
-  try {
-    while (!stop.load()) {
-      if (!source->read(chunk)) {
-        if (!options_.loop) break;
-        summary.decoded += source->decode_counts();
-        source = open_source();
-        ++summary.loops;
-        rebase = true;
-        continue;
-      }
-      summary.events_read += chunk.size();
-      if (chunk.empty()) continue;
-      if (rebase) {
-        offset = validator.newest_time() + options_.batch_us - chunk.t.front();
-        rebase = false;
-      }
-      if (offset != 0) {
-        for (Timestamp& t : chunk.t) t += offset;
-      }
-      validator.filter(chunk);
-      if (chunk.empty()) continue;
-      batcher.push(std::move(chunk));  // chunk gets the storage of a consumed one back
-      publish_ready(live);
-      if (options_.progress_period_s > 0 &&
-          Clock::now() - last_progress > std::chrono::duration<double>(options_.progress_period_s)) {
-        last_progress = Clock::now();
-        spdlog::info("{:.0f}% of {}: {} events in {} batches, {:.2f} s of event time", 100.0 * source->progress(),
-                     source->name(), summary.events_published, summary.batches,
-                     summary.event_seconds);
-      }
-    }
-  } catch (const FormatError& error) {
-    spdlog::error("{} (every event before it was published)", error.what());
-    summary.input_error = error.what();
   }
-  publish_ready(true);
-  summary.decoded += source->decode_counts();
-  summary.drops = validator.drops();
-  summary.skipped_gaps = pacer.skipped_gaps();
-  summary.sensor_lag = sensor_lag_.run_summary();
-  summary.sensor_clock_offset_s = sensor_lag_.clock_offset_s();
-  summary.reconnects = source->reconnects();
-  summary.wall_seconds = std::chrono::duration<double>(Clock::now() - started).count();
-  stats(true);
-  return summary;
+
+  void progress() {
+    if (options_.progress_period_s <= 0 || Clock::now() - last_progress_ <= std::chrono::duration<double>(options_.progress_period_s)) {
+      return;
+    }
+    last_progress_ = Clock::now();
+    spdlog::info("{:.0f}% of {}: {} events in {} batches, {:.2f} s of event time", 100.0 * source_->progress(),
+                 source_->name(), summary_.events_published, summary_.batches, summary_.event_seconds);
+  }
+
+  void stats(bool final) {
+    const auto now = Clock::now();
+    const double period_s = std::chrono::duration<double>(now - last_stats_).count();
+    if (options_.stats_hz <= 0 || (!final && period_s < 1.0 / options_.stats_hz)) return;
+    DecodeCounts decoded = summary_.decoded;
+    if (!final) decoded += source_->decode_counts();  // at the end, summary_.decoded holds them all
+    summary_.reconnects = source_->reconnects();
+    node_.publish_stats(summary_, decoded, final ? summary_.drops : validator_.drops(), period_s,
+                        summary_.events_published - published_at_last_stats_);
+    last_stats_ = now;
+    published_at_last_stats_ = summary_.events_published;
+  }
+
+  CameraNode& node_;
+  const CameraNodeOptions& options_;
+  const SourceFactory& open_source_;
+  const std::atomic<bool>& stop_;
+  std::unique_ptr<EventSource> source_;
+  CameraSummary summary_;
+  EventValidator validator_;
+  EventBatcher batcher_;
+  bool live_;  // not paced, and each read's batches out at once
+  Pacer pacer_;
+  EventBatch chunk_, batch_;
+  std::uint64_t clock_resets_seen_ = 0;
+  Timestamp offset_ = 0;  // added to event times so every loop continues forward in time
+  bool rebase_ = false;
+  Clock::time_point started_ = Clock::now();
+  Clock::time_point last_progress_ = started_;
+  Clock::time_point last_stats_ = started_;
+  std::uint64_t published_at_last_stats_ = 0;
+};
+
+CameraSummary CameraNode::run(const SourceFactory& open_source, const std::atomic<bool>& stop) {
+  return Run(*this, open_source, stop).run();
 }
 
 void CameraNode::publish_stats(const CameraSummary& summary, const DecodeCounts& decoded, const DropCounts& drops,

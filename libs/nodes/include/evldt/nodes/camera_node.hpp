@@ -66,6 +66,8 @@ class CameraNode {
   CameraSummary run(const SourceFactory& open_source, const std::atomic<bool>& stop);
 
  private:
+  class Run;  // the state of one run()
+
   void publish(const EventBatch& batch, CameraSummary& summary);
   /// The statistics so far; `rate_events` published since the last ones, over `period_s`.
   void publish_stats(const CameraSummary& summary, const DecodeCounts& decoded, const DropCounts& drops, double period_s,
