@@ -31,6 +31,7 @@ std::vector<std::string> joined_status(const std::vector<std::vector<std::string
 
 std::vector<evldt::WebLayer> web_layers(const evldt::RenderOptions& render) {
   std::vector<evldt::WebLayer> layers;
+  layers.reserve(std::size(evldt::kLayers));
   for (const evldt::Layer& layer : evldt::kLayers) layers.push_back({layer.key, layer.name, render.*(layer.shown)});
   return layers;
 }

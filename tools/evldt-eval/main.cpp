@@ -510,6 +510,7 @@ void print_and_write(const std::vector<Report>& reports, const Options& options)
   if (!options.json.empty()) write_json(reports, options);
   if (!options.pr_png.empty()) {
     std::vector<PrPoint> points;
+    points.reserve(reports.size());
     for (const Report& r : reports) points.push_back({r.threshold.value_or(0.0f), r.figures.accuracy[0].precision, r.figures.accuracy[0].recall, r.figures.accuracy[0].f});
     write_pr_curve_png(options.pr_png, points, reports.front().label + " PR over f_th (tolerance " +
                                                    std::to_string(options.tolerances[0] * 100).substr(0, 3) + "% of diagonal)");

@@ -109,7 +109,7 @@ class Rosbag2Topic {
     while (sqlite3_step(topics.get()) == SQLITE_ROW) {
       const std::int64_t id = sqlite3_column_int64(topics.get(), 0);
       const std::string name = column_text(topics.get(), 1), type = column_text(topics.get(), 2);
-      listing += (listing.empty() ? "" : ", ") + name + " (" + type + ")";
+      listing.append(listing.empty() ? "" : ", ").append(name).append(" (").append(type).append(")");
       if (topic_id_ >= 0 || (!wanted.empty() && name != wanted)) continue;
       std::string definition = message_definition(type);
       if (!accepts(type, definition)) {

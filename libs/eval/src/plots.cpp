@@ -167,6 +167,7 @@ void write_pr_curve_png(const std::filesystem::path& path, std::span<const PrPoi
     return axes.at(std::clamp(p.recall, 0.0, 1.0), std::clamp(p.precision, 0.0, 1.0));
   };
   std::vector<cv::Point> curve;
+  curve.reserve(shown.size());
   for (const PrPoint& p : shown) curve.push_back(pixel_of(p));
   cv::polylines(image, curve, false, kCurve, 2, cv::LINE_AA);
 

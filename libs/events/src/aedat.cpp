@@ -111,7 +111,7 @@ class Aedat31Decoder final : public EventDecoder {
         std::memcpy(packet_header_.data() + header_bytes_, chunk.data(), take);
         header_bytes_ += take;
         advance(chunk, take);
-        if (header_bytes_ == kPacketHeaderBytes) start_packet();
+        if (header_bytes_ == kPacketHeaderBytes) begin_packet_from_header();
         continue;
       }
       if (!polarity_packet_) {
@@ -163,7 +163,7 @@ class Aedat31Decoder final : public EventDecoder {
     offset_ += count;
   }
 
-  void start_packet() {
+  void begin_packet_from_header() {
     header_bytes_ = 0;
     const auto type = static_cast<std::int16_t>(load_le16(packet_header_.data()));
     const auto event_size = static_cast<std::int32_t>(load_le32(packet_header_.data() + 4));

@@ -105,7 +105,7 @@ std::size_t TextHeader::consume(std::span<const std::uint8_t> bytes, const std::
   std::size_t used = 0;
   while (used < bytes.size() && !complete_) {
     if (!in_line_) {
-      if (bytes[used] != marker_) {
+      if (bytes[used] != static_cast<unsigned char>(marker_)) {
         complete_ = true;
         break;
       }

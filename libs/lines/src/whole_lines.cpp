@@ -319,7 +319,7 @@ void WholeLineTracker::reach_along_events() {
     const Segment& s = published_[i].segment;
     const int steps = 1 + static_cast<int>(std::ceil(s.length() / spacing));
     for (int k = 0; k <= steps; ++k) {
-      line_samples_.push_back(s.q0 + (s.q1 - s.q0) * (static_cast<float>(k) / static_cast<float>(steps)));
+      line_samples_.emplace_back(s.q0 + (s.q1 - s.q0) * (static_cast<float>(k) / static_cast<float>(steps)));
       line_of_sample_.push_back(i);
     }
   }

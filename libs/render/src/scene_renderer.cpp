@@ -53,6 +53,7 @@ bool toggle_layer(RenderOptions& options, int key) {
 
 std::vector<std::string> layer_key_help() {
   std::vector<std::string> fields;
+  fields.reserve(std::size(kLayers) + 1);
   for (const Layer& layer : kLayers) fields.push_back(std::string(fields.empty() ? "keys: " : "") + layer.key + " " + layer.name);
   fields.emplace_back("q quit");
   return fields;

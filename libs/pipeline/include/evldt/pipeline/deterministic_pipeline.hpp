@@ -80,7 +80,7 @@ class DeterministicPipeline {
   void finish_batch(const EventBatch& batch);  // the rounds due by its last event
   void start(Timestamp t0);
   void run_rounds_until(Timestamp t);  // every round due at a time <= t
-  void skip_gap(Timestamp t);
+  void skip_gap(Timestamp resume_from);
   void update_next_due();
 
   PipelineConfig config_;

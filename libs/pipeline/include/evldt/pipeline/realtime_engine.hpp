@@ -55,7 +55,7 @@ class RealtimeEngine {
 
   /// Filters and stores on-sensor, time-ordered events (from one producer thread), each `copies`
   /// times (a thinned batch: stored_copies()).
-  void process(const EventBatch& batch, int copies = 1);
+  void process(const EventBatch& input, int copies = 1);
   /// How many times each event of a batch thinned to every stride-th is stored: stride / 2, at least
   /// once. A block's ring then fills at half the pace of the whole stream at any stride, so it never
   /// reaches back more than twice the time it would unthinned. Kept once, every 4th event made the
