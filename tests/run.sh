@@ -32,7 +32,8 @@ for suite in "${suites[@]}"; do
   fi
   test_suite "$suite"
   if [[ $suite == release && -z $mode ]]; then
-    echo "=== clang-tidy ($((SECONDS - started)) s so far)"
+    echo "=== clang-format and clang-tidy ($((SECONDS - started)) s so far)"
+    tests/lint/format.sh
     tests/lint/clang_tidy.py build/release
   fi
   if [[ $mode == --quick ]]; then break; fi

@@ -22,8 +22,8 @@ int main(int argc, char** argv) {
     std::printf("%s %s t_us %lld lines %zu\n", list.whole_lines ? "whole-lines" : "segments", list.camera.c_str(),
                 static_cast<long long>(list.t_us), list.lines.size());
     for (const evldt::client::Line& line : list.lines) {
-      std::printf("  id %lld (%.1f, %.1f) - (%.1f, %.1f) score %.2f\n", static_cast<long long>(line.id), line.x0, line.y0,
-                  line.x1, line.y1, line.score);
+      std::printf("  id %lld (%.1f, %.1f) - (%.1f, %.1f) score %.2f\n", static_cast<long long>(line.id), line.x0,
+                  line.y0, line.x1, line.y1, line.score);
     }
     std::fflush(stdout);
     ++lists;

@@ -1,24 +1,25 @@
 // evldt-lines: SCARF storage, line detection and tracking on one camera's events from LCM;
 // publishes the live segments on LINES_<CAMERA> and its statistics on EVLDT_STATS.
 
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <optional>
-#include <spdlog/spdlog.h>
 
 #include "evldt/app/lcm_options.hpp"
 #include "evldt/app/pipeline_options.hpp"
-#include "evldt/pipeline/thread_name.hpp"
 #include "evldt/nodes/lines_node.hpp"
+#include "evldt/pipeline/thread_name.hpp"
 #include "evldt/transport/channels.hpp"
 
 int main(int argc, char** argv) {
   using namespace evldt;
-  CLI::App app{"evldt-lines: detect and track line segments in real time from EVENTS_<CAMERA> (LCM).\n"
-               "Publishes evldt.segment_list_t on LINES_<CAMERA> at --publish-hz and evldt.stats_t on EVLDT_STATS\n"
-               "once a second. The sensor size comes from the first batch unless --width/--height or --config set it (then the\n"
-               "lattice and filters are built at start, and the first batches do not queue behind them).\n"
-               "Runs until SIGINT/SIGTERM, then prints a summary."};
+  CLI::App app{
+      "evldt-lines: detect and track line segments in real time from EVENTS_<CAMERA> (LCM).\n"
+      "Publishes evldt.segment_list_t on LINES_<CAMERA> at --publish-hz and evldt.stats_t on EVLDT_STATS\n"
+      "once a second. The sensor size comes from the first batch unless --width/--height or --config set it (then the\n"
+      "lattice and filters are built at start, and the first batches do not queue behind them).\n"
+      "Runs until SIGINT/SIGTERM, then prints a summary."};
   LcmOptions lcm_options;
   PipelineOptions pipeline_options;
   LinesNodeOptions options;
@@ -37,8 +38,8 @@ int main(int argc, char** argv) {
   app.add_option("--overload", options.overload,
                  "What a batch that queued past the latency budget meets: thin (a share of its events kept, evenly; "
                  "shed past twice the budget) or shed (the whole batch, unstored)")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, OverloadPolicy>{{"thin", OverloadPolicy::Thin},
-                                                                                {"shed", OverloadPolicy::Shed}}))
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, OverloadPolicy>{{"thin", OverloadPolicy::Thin}, {"shed", OverloadPolicy::Shed}}))
       ->default_str("thin");
   app.add_option("--stats-hz", options.stats_hz, "Statistics messages per second")
       ->capture_default_str()
@@ -80,8 +81,9 @@ int main(int argc, char** argv) {
     }
     const auto lcm = lcm_options.connect();
     LinesNode node(*lcm, options, process_epoch_us());
-    announce_ready("evldt-lines", fmt::format("listening on {} ({}), publishing {} at {} Hz", events_channel(options.camera),
-                                              lcm_options.effective_url(), lines_channel(options.camera), options.publish_hz));
+    announce_ready("evldt-lines",
+                   fmt::format("listening on {} ({}), publishing {} at {} Hz", events_channel(options.camera),
+                               lcm_options.effective_url(), lines_channel(options.camera), options.publish_hz));
     node.run(stop);
     node.totals().print(stdout, options);
     return 0;

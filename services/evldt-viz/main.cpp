@@ -1,13 +1,13 @@
 // evldt-viz: draws one camera's events (SCARF surface), segments (coloured by status) and whole
 // lines from LCM, in a window, a web page (--http) and/or headless into an mp4 and PNG snapshots.
 
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <opencv2/highgui.hpp>
 #include <optional>
-#include <spdlog/spdlog.h>
 
 #include "evldt/app/lcm_options.hpp"
 #include "evldt/app/pipeline_options.hpp"
@@ -40,12 +40,13 @@ std::vector<evldt::WebLayer> web_layers(const evldt::RenderOptions& render) {
 
 int main(int argc, char** argv) {
   using namespace evldt;
-  CLI::App app{"evldt-viz: show events, segments and whole lines of EVENTS_<CAMERA>, LINES_<CAMERA> and\n"
-               "WHOLE_LINES_<CAMERA> (LCM), with the rates of EVLDT_STATS. Colours: cyan whole lines (with ids), below them\n"
-               "segments yellow detected, green good track, red bad track. A window unless --headless or no display;\n"
-               "--http serves the same picture to browsers (robots without a display); --video and --png-dir record it.\n"
-               "Runs until SIGINT/SIGTERM (or q in the window). Keys (window) and buttons (web page) toggle layers:\n"
-               "e events, s segments, b bad tracks, w whole lines, i whole-line ids, n segment ids, g block grid."};
+  CLI::App app{
+      "evldt-viz: show events, segments and whole lines of EVENTS_<CAMERA>, LINES_<CAMERA> and\n"
+      "WHOLE_LINES_<CAMERA> (LCM), with the rates of EVLDT_STATS. Colours: cyan whole lines (with ids), below them\n"
+      "segments yellow detected, green good track, red bad track. A window unless --headless or no display;\n"
+      "--http serves the same picture to browsers (robots without a display); --video and --png-dir record it.\n"
+      "Runs until SIGINT/SIGTERM (or q in the window). Keys (window) and buttons (web page) toggle layers:\n"
+      "e events, s segments, b bad tracks, w whole lines, i whole-line ids, n segment ids, g block grid."};
   LcmOptions lcm_options;
   VizNodeOptions options;
   std::filesystem::path video, png_dir;
@@ -54,9 +55,10 @@ int main(int argc, char** argv) {
   std::string http;
   lcm_options.add_to(app);
   app.add_flag("--headless", headless, "No window (for robots and CI): serve --http and/or write --video, --png-dir");
-  app.add_option("--http", http,
-                 "Serve a live web view on [ADDR:]PORT (e.g. 8080: every interface; 127.0.0.1:8080: this host only; port 0: any "
-                 "free one, announced); without a display there is then no window");
+  app.add_option(
+      "--http", http,
+      "Serve a live web view on [ADDR:]PORT (e.g. 8080: every interface; 127.0.0.1:8080: this host only; port 0: any "
+      "free one, announced); without a display there is then no window");
   app.add_option("--video", video, "Write an mp4 of the frames");
   app.add_option("--png-dir", png_dir, "Write a PNG snapshot every --png-period-s into this directory");
   app.add_option("--png-period-s", png_period_s, "Time between PNG snapshots")
@@ -76,14 +78,16 @@ int main(int argc, char** argv) {
     // OpenCV's window toolkit aborts the process when it finds no display: no window then.
     const bool window = !headless && display;
     if (!window && http.empty() && video.empty() && png_dir.empty()) {
-      throw std::invalid_argument(headless ? "--headless shows nothing: add --http [ADDR:]PORT, --video FILE and/or --png-dir DIR"
-                                           : "no display (DISPLAY is not set): add --http [ADDR:]PORT for a web view, or --headless "
-                                             "with --video FILE and/or --png-dir DIR");
+      throw std::invalid_argument(
+          headless ? "--headless shows nothing: add --http [ADDR:]PORT, --video FILE and/or --png-dir DIR"
+                   : "no display (DISPLAY is not set): add --http [ADDR:]PORT for a web view, or --headless "
+                     "with --video FILE and/or --png-dir DIR");
     }
     options.camera = lcm_options.camera();
     options.show_key_help = window;
     std::optional<WebView> web;
-    if (!http.empty()) web.emplace(WebViewOptions{.address = parse_http_address(http), .title = "evldt-viz " + options.camera});
+    if (!http.empty())
+      web.emplace(WebViewOptions{.address = parse_http_address(http), .title = "evldt-viz " + options.camera});
     const auto& stop = stop_on_signals();
     const auto lcm = lcm_options.connect();
     VizNode node(*lcm, options);
@@ -96,12 +100,14 @@ int main(int argc, char** argv) {
     const std::string window_name = "evldt-viz " + lcm_options.camera();
     node.run(stop, [&](const cv::Mat& frame) {
       // Writers open at the first frame: only then is the sensor size known.
-      if (!video.empty() && !video_writer) video_writer.emplace(video, std::filesystem::path(), options.render_hz, frame.size());
+      if (!video.empty() && !video_writer)
+        video_writer.emplace(video, std::filesystem::path(), options.render_hz, frame.size());
       if (video_writer) video_writer->write(frame);
       if (!png_dir.empty() && std::chrono::steady_clock::now() >= next_png) {
         if (!png_writer) png_writer.emplace(std::filesystem::path(), png_dir, 1.0, frame.size());
         png_writer->write(frame);
-        next_png = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(png_period);
+        next_png = std::chrono::steady_clock::now() +
+                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(png_period);
       }
       if (web) {
         web->publish(frame, joined_status(node.status()), web_layers(node.render_options()));

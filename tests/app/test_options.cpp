@@ -34,8 +34,9 @@ TEST(PipelineOptions, EachShippedConfigGivesTheDesignDefaults) {
     int block_size;
     float perturbation;
   };
-  for (const Expect& e : {Expect{"240x180.toml", {240, 180}, 8, 0.8f}, Expect{"346x260.toml", {346, 260}, 8, 1.1f},
-                          Expect{"640x480.toml", {640, 480}, 14, 2.5f}, Expect{"1280x720.toml", {1280, 720}, 14, 2.5f}}) {
+  for (const Expect& e :
+       {Expect{"240x180.toml", {240, 180}, 8, 0.8f}, Expect{"346x260.toml", {346, 260}, 8, 1.1f},
+        Expect{"640x480.toml", {640, 480}, 14, 2.5f}, Expect{"1280x720.toml", {1280, 720}, 14, 2.5f}}) {
     PipelineOptions options;
     ASSERT_EQ(parse({"--config", (kConfigDir / e.file).string()}, options), 0) << e.file;
     ASSERT_TRUE(options.sensor()) << e.file;
@@ -56,9 +57,10 @@ TEST(PipelineOptions, EachShippedConfigGivesTheDesignDefaults) {
 
 TEST(PipelineOptions, CommandLineOverridesTheFile) {
   PipelineOptions options;
-  ASSERT_EQ(parse({"--config", (kConfigDir / "640x480.toml").string(), "--block-size", "10", "--multi-block-norm", "union"},
-                  options),
-            0);
+  ASSERT_EQ(
+      parse({"--config", (kConfigDir / "640x480.toml").string(), "--block-size", "10", "--multi-block-norm", "union"},
+            options),
+      0);
   const PipelineConfig config = options.resolve(*options.sensor());
   EXPECT_EQ(config.lattice.block_size, 10);
   EXPECT_EQ(config.track.multi_block_norm, EffectiveRatioNorm::Union);
@@ -125,7 +127,8 @@ TEST(Parameters, EachSetsItsOwnFieldAndNoOther) {
     for (const std::string& candidate : candidates) {
       if (candidate == old_value) continue;
       PipelineOptions options;
-      ASSERT_EQ(parse({"--" + std::string(parameter.flag), candidate}, options), 0) << parameter.flag << " " << candidate;
+      ASSERT_EQ(parse({"--" + std::string(parameter.flag), candidate}, options), 0)
+          << parameter.flag << " " << candidate;
       try {
         config = options.resolve(sensor);
       } catch (const std::invalid_argument&) {
@@ -139,7 +142,8 @@ TEST(Parameters, EachSetsItsOwnFieldAndNoOther) {
       if (&other == &parameter) {
         EXPECT_EQ(other.value_in(config), value) << other.flag;
       } else {
-        EXPECT_EQ(other.value_in(config), other.value_in(defaults)) << "--" << parameter.flag << " changed " << other.flag;
+        EXPECT_EQ(other.value_in(config), other.value_in(defaults))
+            << "--" << parameter.flag << " changed " << other.flag;
       }
     }
   }
@@ -162,7 +166,8 @@ TEST(Parameters, NumbersOutOfRangeOrOfTheWrongTypeAreRefused) {
   for (const Parameter& parameter : pipeline_parameters()) {
     if (parameter.type == Parameter::Type::Text) continue;
     PipelineOptions above, text, fraction;
-    EXPECT_NE(parse({"--" + std::string(parameter.flag), std::to_string(parameter.max * 2 + 1)}, above), 0) << parameter.flag;
+    EXPECT_NE(parse({"--" + std::string(parameter.flag), std::to_string(parameter.max * 2 + 1)}, above), 0)
+        << parameter.flag;
     EXPECT_NE(parse({"--" + std::string(parameter.flag), "many"}, text), 0) << parameter.flag;
     if (parameter.type == Parameter::Type::Integer) {
       EXPECT_NE(parse({"--" + std::string(parameter.flag), "2.5"}, fraction), 0) << parameter.flag;

@@ -7,8 +7,8 @@
 #include <opencv2/calib3d.hpp>
 
 #include "evldt/calibration/camera_model.hpp"
-#include "evldt/pipeline/deterministic_pipeline.hpp"
 #include "evldt/calibration/rectifier.hpp"
+#include "evldt/pipeline/deterministic_pipeline.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
 
@@ -19,8 +19,8 @@ const std::filesystem::path kFixtures = EVLDT_SOURCE_DIR "/tests/data/calibratio
 
 TEST(CameraModel, EveryFormatReadsTheSameCamera) {
   // The Event Camera Dataset's DAVIS240C, as each tool writes it.
-  for (const char* file : {"davis240c_calib.txt", "davis240c_camera_info.yaml", "davis240c_camchain.yaml", "davis240c_opencv.yaml",
-                           "davis240c_opencv.xml"}) {
+  for (const char* file : {"davis240c_calib.txt", "davis240c_camera_info.yaml", "davis240c_camchain.yaml",
+                           "davis240c_opencv.yaml", "davis240c_opencv.xml"}) {
     SCOPED_TRACE(file);
     const CameraModel model = read_camera_model(kFixtures / file);
     EXPECT_DOUBLE_EQ(model.fx, 199.092366542);
@@ -60,15 +60,17 @@ TEST(CameraModel, UndistortionInvertsTheLens) {
     int checked = 0;
     for (int y = 0; y < model.size.height; y += 17) {
       for (int x = 0; x < model.size.width; x += 23) {
-        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(model.size.width) + static_cast<std::size_t>(x);
+        const std::size_t i =
+            static_cast<std::size_t>(y) * static_cast<std::size_t>(model.size.width) + static_cast<std::size_t>(x);
         // Back to normalised coordinates, then through the lens (OpenCV: a pixel's centre at its index).
-        const cv::Point2d normalised((centres[2 * i] - 0.5 - model.cx) / model.fx, (centres[2 * i + 1] - 0.5 - model.cy) / model.fy);
+        const cv::Point2d normalised((centres[2 * i] - 0.5 - model.cx) / model.fx,
+                                     (centres[2 * i + 1] - 0.5 - model.cy) / model.fy);
         std::vector<cv::Point2d> back;
         if (model.distortion == CameraModel::Distortion::Equidistant) {
           cv::fisheye::distortPoints(std::vector<cv::Point2d>{normalised}, back, k, model.coefficients);
         } else {
-          cv::projectPoints(std::vector<cv::Point3d>{{normalised.x, normalised.y, 1.0}}, cv::Vec3d::zeros(), cv::Vec3d::zeros(), k,
-                            model.coefficients, back);
+          cv::projectPoints(std::vector<cv::Point3d>{{normalised.x, normalised.y, 1.0}}, cv::Vec3d::zeros(),
+                            cv::Vec3d::zeros(), k, model.coefficients, back);
         }
         EXPECT_NEAR(back[0].x, x, 0.01) << "pixel " << x << ", " << y;
         EXPECT_NEAR(back[0].y, y, 0.01) << "pixel " << x << ", " << y;
@@ -108,8 +110,9 @@ TEST(CameraModel, TheLensMovesTheCornersNotTheCentre) {
   for (std::size_t pixel = 0; pixel < 240 * 180; ++pixel) squeezed += feeds(pixel) > 1;
   EXPECT_GT(squeezed, 100u);
   EXPECT_EQ(table->targets.size(), 240u * 180u);
-  EXPECT_THROW(static_cast<void>(rectification_table(read_camera_model(kFixtures / "davis240c_camera_info.yaml"), {346, 260})),
-               std::invalid_argument);
+  EXPECT_THROW(
+      static_cast<void>(rectification_table(read_camera_model(kFixtures / "davis240c_camera_info.yaml"), {346, 260})),
+      std::invalid_argument);
 }
 
 TEST(CameraModel, ABadFileSaysWhichAndWhy) {
@@ -128,7 +131,8 @@ TEST(CameraModel, ABadFileSaysWhichAndWhy) {
   expect_error("short.txt", "199 198 132 110 -0.3 0.1 0\n", "found 7 numbers");
   expect_error("word.txt", "199 198 f 110\n", "'f' is not a number");
   expect_error("matrix.yaml", "camera_matrix:\n  data: [1, 0, 0, 0, 1, 0, 0, 0]\n", "9 numbers");
-  expect_error("model.yaml", "camera_matrix:\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\ndistortion_model: spline\n", "spline");
+  expect_error("model.yaml", "camera_matrix:\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\ndistortion_model: spline\n",
+               "spline");
   expect_error("fisheye.yaml",
                "cam0:\n  camera_model: pinhole\n  intrinsics: [1, 1, 0, 0]\n  distortion_model: equidistant\n  "
                "distortion_coeffs: [0.1, 0, 0, 0, 0]\n",

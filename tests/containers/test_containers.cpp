@@ -23,8 +23,8 @@
 #include "evldt/containers/image_source.hpp"
 #include "evldt/containers/mcap.hpp"
 #include "evldt/containers/packet_source.hpp"
-#include "evldt/containers/rosbag1.hpp"
 #include "evldt/containers/ros_messages.hpp"
+#include "evldt/containers/rosbag1.hpp"
 #include "evldt/containers/rosbag2.hpp"
 #include "evldt/events/event_writer.hpp"
 #include "evldt/events/size_prefixed_flatbuffer.hpp"
@@ -32,7 +32,6 @@
 #include "support/raw_ros_message.hpp"
 #include "support/ros2_bag_writer.hpp"
 #include "support/temp_dir.hpp"
-
 
 namespace evldt {
 namespace {
@@ -136,8 +135,7 @@ TEST(Cdr, EventPacketDecodesInEitherByteOrderAndRefusesTruncation) {
     EXPECT_EQ(message.encoding, "libcaer");
     EXPECT_EQ(std::vector<std::uint8_t>(message.events.begin(), message.events.end()), fields.events);
     for (std::size_t cut = 0; cut < bytes.size(); cut += 3) {
-      EXPECT_THROW(layout->decode(std::span(bytes).first(cut), scratch), std::runtime_error)
-          << cut;
+      EXPECT_THROW(layout->decode(std::span(bytes).first(cut), scratch), std::runtime_error) << cut;
     }
   }
 }
@@ -158,7 +156,8 @@ TEST(Rosbag2, Evt3PacketsAreOneStreamSplitAnywhere) {
     for (std::size_t at = 0, seq = 0; at < words.size(); ++seq) {
       const std::size_t size = std::min<std::size_t>(words.size() - at, 2 * (37 + 101 * (seq % 5)));
       fields.seq = seq;
-      fields.events.assign(words.begin() + static_cast<std::ptrdiff_t>(at), words.begin() + static_cast<std::ptrdiff_t>(at + size));
+      fields.events.assign(words.begin() + static_cast<std::ptrdiff_t>(at),
+                           words.begin() + static_cast<std::ptrdiff_t>(at + size));
       bag.message(2, 100 + static_cast<std::int64_t>(seq), event_packet_cdr(fields));
       at += size;
     }
@@ -188,9 +187,10 @@ TEST(Rosbag2, AMessageOfThePacketFamilyIsReadByTheDefinitionTheBagKeeps) {
   {
     BagWriter bag(path);
     bag.topic(1, "/event_camera/events", "event_array_msgs/msg/EventArray");
-    bag.definition("event_array_msgs/msg/EventArray",
-                   "std_msgs/Header header\nstring encoding\nuint32 height\nuint32 width\nuint64 seq\nuint64 time_base\n"
-                   "bool is_bigendian\nuint8[] events\n");
+    bag.definition(
+        "event_array_msgs/msg/EventArray",
+        "std_msgs/Header header\nstring encoding\nuint32 height\nuint32 width\nuint64 seq\nuint64 time_base\n"
+        "bool is_bigendian\nuint8[] events\n");
     CdrWriter cdr(true);
     cdr.put<std::int32_t>(1700000000);
     cdr.put<std::uint32_t>(123);
@@ -214,7 +214,8 @@ TEST(Rosbag2, LibcaerPacketsCountFromTheirTimeBaseAcrossTheTimeWrap) {
   TempDir dir;
   const auto path = dir.file("davis.db3");
   auto record = [](std::vector<std::uint8_t>& out, int x, int y, bool on, std::int32_t time, bool valid = true) {
-    append_le32(out, static_cast<std::uint32_t>(x) << 17 | static_cast<std::uint32_t>(y) << 2 | (on ? 2u : 0u) | (valid ? 1u : 0u));
+    append_le32(out, static_cast<std::uint32_t>(x) << 17 | static_cast<std::uint32_t>(y) << 2 | (on ? 2u : 0u) |
+                         (valid ? 1u : 0u));
     append_le32(out, static_cast<std::uint32_t>(time));
   };
   {
@@ -238,9 +239,9 @@ TEST(Rosbag2, LibcaerPacketsCountFromTheirTimeBaseAcrossTheTimeWrap) {
   const Timestamp base = 7'000'000'000;
   const Timestamp wrap = Timestamp{1} << 31;
   EXPECT_EQ(result.events, (std::vector<Event>{{base + 10, 1, 2, 1},
-                                                {base + 2147483640, 3, 4, -1},
-                                                {base + wrap + 3, 5, 6, 1},
-                                                {base + wrap + 20, 7, 8, -1}}));
+                                               {base + 2147483640, 3, 4, -1},
+                                               {base + wrap + 3, 5, 6, 1},
+                                               {base + wrap + 20, 7, 8, -1}}));
   EXPECT_EQ(result.counts.skipped_words, 1u);  // the invalid record
   EXPECT_EQ(result.sensor, (SensorSize{346, 260}));
 }
@@ -255,19 +256,22 @@ TEST(Rosbag2, LibcaerCompressedColumnsVectorsAndPerPacketTime) {
     packet.time_base = 2'000'000;  // 2000 us
     // t = 0x001 << 12 | 0x005 us: x 17, one event (y 3, ON), then a vector at base y 8 (OFF): 8 and 10;
     // an unknown code 0x9, skipped; then x 18 and one event at y 260 - 1.
-    for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x0001, 0x1005, 0x2011, 0x3803, 0x4008, 0x5005, 0x9ABC, 0x2012, 0x3103}) {
+    for (const std::uint16_t word :
+         std::initializer_list<std::uint16_t>{0x0001, 0x1005, 0x2011, 0x3803, 0x4008, 0x5005, 0x9ABC, 0x2012, 0x3103}) {
       append_le16(packet.events, word);
     }
     bag.message(1, 1, event_packet_cdr(packet));
     packet.events.clear();
     packet.time_base = 3'000'000;  // the time starts again at the next packet's base; x carries over
-    for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x1002, 0x3804}) append_le16(packet.events, word);
+    for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x1002, 0x3804})
+      append_le16(packet.events, word);
     bag.message(1, 2, event_packet_cdr(packet));
   }
   const ReadAll result = read_all(path);
   EXPECT_EQ(result.error, "");
   const Timestamp t = 2000 + (1 << 12) + 5;
-  EXPECT_EQ(result.events, (std::vector<Event>{{t, 17, 3, 1}, {t, 17, 8, -1}, {t, 17, 10, -1}, {t, 18, 259, -1}, {3002, 18, 4, 1}}));
+  EXPECT_EQ(result.events,
+            (std::vector<Event>{{t, 17, 3, 1}, {t, 17, 8, -1}, {t, 17, 10, -1}, {t, 18, 259, -1}, {3002, 18, 4, 1}}));
   EXPECT_EQ(result.counts.skipped_words, 1u);
 }
 
@@ -322,7 +326,7 @@ TEST(Rosbag2, MonoPacketsCountNanosecondsFromTheirTimeBase) {
     PacketFields packet{.frame_id = "imx636", .width = 1280, .height = 720, .encoding = "mono", .events = {}};
     packet.time_base = 5'000'000'000'500ULL;  // ns
     append_mono(packet.events, 0, 1279, 719, true);
-    append_mono(packet.events, 499, 0, 0, false);       // 5'000'000'000'999 ns: still the same us
+    append_mono(packet.events, 499, 0, 0, false);              // 5'000'000'000'999 ns: still the same us
     append_mono(packet.events, 4'000'000'000u, 17, 33, true);  // 4 s on: the full 32 bits
     bag.message(1, 1, event_packet_cdr(packet));
     packet.events.resize(12);  // a word cut short
@@ -330,7 +334,9 @@ TEST(Rosbag2, MonoPacketsCountNanosecondsFromTheirTimeBase) {
   }
   const ReadAll result = read_all(path);
   const Timestamp base = 5'000'000'000;
-  EXPECT_EQ(result.events, (std::vector<Event>{{base, 1279, 719, 1}, {base, 0, 0, -1}, {base + 4'000'000, 17, 33, 1}, {base, 1279, 719, 1}}));
+  EXPECT_EQ(result.events,
+            (std::vector<Event>{
+                {base, 1279, 719, 1}, {base, 0, 0, -1}, {base + 4'000'000, 17, 33, 1}, {base, 1279, 719, 1}}));
   EXPECT_NE(result.error.find("inside an 8-byte event"), std::string::npos) << result.error;
   EXPECT_EQ(result.sensor, (SensorSize{1280, 720}));
 }
@@ -375,7 +381,8 @@ TEST(Rosbag2, DvsEventArraysInCdrOfEitherByteOrder) {
   EXPECT_EQ(result.error, "");
   EXPECT_EQ(result.events, events_of(events));
   EXPECT_EQ(result.sensor, (SensorSize{640, 480}));
-  EXPECT_NE(result.name.find("/dvs/events (dvs_msgs/msg/EventArray), camera dvxplorer"), std::string::npos) << result.name;
+  EXPECT_NE(result.name.find("/dvs/events (dvs_msgs/msg/EventArray), camera dvxplorer"), std::string::npos)
+      << result.name;
 }
 
 // ---- ROS 1 bags -----------------------------------------------------------------------------------
@@ -414,9 +421,11 @@ TEST(Rosbag1, DvsEventArraysInEveryChunkCompressionAndEventPackets) {
   const auto path = dir.file("ecd.bag");
   EventBatch events;
   for (int i = 0; i < 3000; ++i) {
-    events.push_back(1'468'940'000'000'000 + 17 * i, static_cast<std::uint16_t>(i % 240), static_cast<std::uint16_t>(i % 180), i % 2 ? 1 : -1);
+    events.push_back(1'468'940'000'000'000 + 17 * i, static_cast<std::uint16_t>(i % 240),
+                     static_cast<std::uint16_t>(i % 180), i % 2 ? 1 : -1);
   }
-  for (const auto compression : {rosbag::compression::Uncompressed, rosbag::compression::BZ2, rosbag::compression::LZ4}) {
+  for (const auto compression :
+       {rosbag::compression::Uncompressed, rosbag::compression::BZ2, rosbag::compression::LZ4}) {
     SCOPED_TRACE(static_cast<int>(compression));
     {
       rosbag::Bag bag(path.string(), rosbag::bagmode::Write);
@@ -432,7 +441,8 @@ TEST(Rosbag1, DvsEventArraysInEveryChunkCompressionAndEventPackets) {
     EXPECT_EQ(result.error, "");
     EXPECT_EQ(result.events, events_of(events));
     EXPECT_EQ(result.sensor, (SensorSize{240, 180}));
-    EXPECT_NE(result.name.find("ROS 1 bag, /dvs/events (dvs_msgs/EventArray), camera dvs"), std::string::npos) << result.name;
+    EXPECT_NE(result.name.find("ROS 1 bag, /dvs/events (dvs_msgs/EventArray), camera dvs"), std::string::npos)
+        << result.name;
   }
   try {
     read_all(path, "/imu");
@@ -555,7 +565,8 @@ std::vector<std::uint8_t> compress(aedat4::CompressionType compression, const st
       out.resize(ZSTD_compress(out.data(), out.size(), data.data(), data.size(), 3));
       return out;
     }
-    default: return data;
+    default:
+      return data;
   }
 }
 
@@ -577,17 +588,25 @@ std::vector<std::uint8_t> stored(const flatbuffers::FlatBufferBuilder& builder, 
 }
 
 /// A DV event packet of events [from, to).
-std::vector<std::uint8_t> dv_event_packet(const EventBatch& events, std::size_t from, std::size_t to, FlatBufferLayout layout) {
+std::vector<std::uint8_t> dv_event_packet(const EventBatch& events, std::size_t from, std::size_t to,
+                                          FlatBufferLayout layout) {
   flatbuffers::FlatBufferBuilder builder;
   std::vector<dv::Event> elements;
   for (std::size_t i = from; i < to; ++i) {
-    elements.emplace_back(events.t[i], static_cast<std::int16_t>(events.x[i]), static_cast<std::int16_t>(events.y[i]), events.p[i] > 0);
+    elements.emplace_back(events.t[i], static_cast<std::int16_t>(events.x[i]), static_cast<std::int16_t>(events.y[i]),
+                          events.p[i] > 0);
   }
   const auto packet = dv::CreateEventPacket(builder, builder.CreateVectorOfStructs(elements));
   switch (layout) {
-    case FlatBufferLayout::Dv: dv::FinishSizePrefixedEventPacketBuffer(builder, packet); break;
-    case FlatBufferLayout::Other: builder.FinishSizePrefixed(packet); break;
-    case FlatBufferLayout::SizeInFront: builder.Finish(packet); break;
+    case FlatBufferLayout::Dv:
+      dv::FinishSizePrefixedEventPacketBuffer(builder, packet);
+      break;
+    case FlatBufferLayout::Other:
+      builder.FinishSizePrefixed(packet);
+      break;
+    case FlatBufferLayout::SizeInFront:
+      builder.Finish(packet);
+      break;
   }
   return stored(builder, layout);
 }
@@ -611,13 +630,15 @@ const char* kInfoXml = R"(<dv version="2.0">
 
 /// An AEDAT 4.0 file: the events in packets of `per_packet` on stream 4, an IMU packet (stream 1)
 /// between them. Returns where each packet header starts.
-std::vector<std::uint64_t> write_aedat4(const std::filesystem::path& path, const EventBatch& events, std::size_t per_packet,
-                                        aedat4::CompressionType compression, FlatBufferLayout layout = FlatBufferLayout::Dv) {
+std::vector<std::uint64_t> write_aedat4(const std::filesystem::path& path, const EventBatch& events,
+                                        std::size_t per_packet, aedat4::CompressionType compression,
+                                        FlatBufferLayout layout = FlatBufferLayout::Dv) {
   std::vector<std::uint8_t> file(kAedat4Magic.begin(), kAedat4Magic.end());
   flatbuffers::FlatBufferBuilder header_builder;
   switch (layout) {
     case FlatBufferLayout::Dv:
-      aedat4::FinishSizePrefixedIOHeaderBuffer(header_builder, aedat4::CreateIOHeaderDirect(header_builder, compression, -1, kInfoXml));
+      aedat4::FinishSizePrefixedIOHeaderBuffer(header_builder,
+                                               aedat4::CreateIOHeaderDirect(header_builder, compression, -1, kInfoXml));
       break;
     case FlatBufferLayout::Other: {
       // The fields added in reverse: the table lists the string first and the compression last.
@@ -649,7 +670,8 @@ std::vector<std::uint64_t> write_aedat4(const std::filesystem::path& path, const
     packet(4, dv_event_packet(events, at, std::min(events.size(), at + per_packet), layout));
     packet(1, std::vector<std::uint8_t>(40, 7));  // not events: skipped
   }
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
   return packet_starts;
 }
 
@@ -657,9 +679,11 @@ TEST(Aedat4, PolarityPacketsInEveryCompressionWithSensorAndCameraFromTheHeader) 
   TempDir dir;
   EventBatch events;
   for (int i = 0; i < 2000; ++i) {
-    events.push_back(1'605'537'493'718'345 + i, static_cast<std::uint16_t>(i % 346), static_cast<std::uint16_t>(i % 260), i % 2 ? 1 : -1);
+    events.push_back(1'605'537'493'718'345 + i, static_cast<std::uint16_t>(i % 346),
+                     static_cast<std::uint16_t>(i % 260), i % 2 ? 1 : -1);
   }
-  for (const auto compression : {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
+  for (const auto compression :
+       {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
     SCOPED_TRACE(static_cast<int>(compression));
     const auto path = dir.file("rec.aedat4");
     write_aedat4(path, events, 300, compression);
@@ -675,7 +699,8 @@ TEST(Aedat4, PolarityPacketsInEveryCompressionWithSensorAndCameraFromTheHeader) 
 TEST(Aedat4, AHeaderInAnotherFieldOrderWithoutTheIdentifierReadsInEveryCompression) {
   TempDir dir;
   const EventBatch events = sweep_events(1000, 100);
-  for (const auto compression : {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
+  for (const auto compression :
+       {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
     SCOPED_TRACE(static_cast<int>(compression));
     const auto path = dir.file("other.aedat4");
     write_aedat4(path, events, 300, compression, FlatBufferLayout::Other);
@@ -696,7 +721,8 @@ TEST(Aedat4, FlatBuffersWithTheirSizePutInFrontReadAsDvsInEveryCompression) {
   write_aedat4(dv_path, events, 300, aedat4::CompressionType::LZ4);
   const ReadAll from_dv = read_all(dv_path);
   ASSERT_EQ(from_dv.error, "");
-  for (const auto compression : {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
+  for (const auto compression :
+       {aedat4::CompressionType::NONE, aedat4::CompressionType::LZ4, aedat4::CompressionType::ZSTD}) {
     SCOPED_TRACE(static_cast<int>(compression));
     const auto path = dir.file("aedat-library.aedat4");
     write_aedat4(path, events, 300, compression, FlatBufferLayout::SizeInFront);
@@ -768,7 +794,8 @@ class McapWriter {
     record(target(), 0x04, le(id, 2) + le(schema, 2) + string_field(topic) + string_field(encoding) + le(0, 4));
   }
   void message(std::uint16_t channel, std::uint64_t time, const std::vector<std::uint8_t>& data) {
-    record(target(), 0x05, le(channel, 2) + le(sequence_++, 4) + le(time, 8) + le(time, 8) + std::string(data.begin(), data.end()));
+    record(target(), 0x05,
+           le(channel, 2) + le(sequence_++, 4) + le(time, 8) + le(time, 8) + std::string(data.begin(), data.end()));
   }
   /// Ends the chunk being written; returns where it starts in the file.
   std::uint64_t end_chunk(bool corrupt_crc = false) {
@@ -778,9 +805,11 @@ class McapWriter {
     std::vector<std::uint8_t> stored = records;
     if (*compression_ == "lz4") stored = compress(aedat4::CompressionType::LZ4, records);
     if (*compression_ == "zstd") stored = compress(aedat4::CompressionType::ZSTD, records);
-    const auto crc = static_cast<std::uint32_t>(crc32(0, records.data(), static_cast<uInt>(records.size()))) ^ (corrupt_crc ? 1u : 0u);
-    record(file_, 0x06, le(0, 8) + le(0, 8) + le(records.size(), 8) + le(crc, 4) + string_field(*compression_) + le(stored.size(), 8) +
-                            std::string(stored.begin(), stored.end()));
+    const auto crc = static_cast<std::uint32_t>(crc32(0, records.data(), static_cast<uInt>(records.size()))) ^
+                     (corrupt_crc ? 1u : 0u);
+    record(file_, 0x06,
+           le(0, 8) + le(0, 8) + le(records.size(), 8) + le(crc, 4) + string_field(*compression_) +
+               le(stored.size(), 8) + std::string(stored.begin(), stored.end()));
     chunk_.clear();
     return at;
   }
@@ -819,8 +848,9 @@ TEST(Mcap, EventPacketsInChunksOfEveryCompressionOrNone) {
   const EventBatch events = sweep_events(4000, 9'000'000);
   std::vector<std::uint8_t> words;
   detail::make_evt3_encoder({640, 480})->encode(events, words);
-  for (const std::optional<std::string>& compression : {std::optional<std::string>(), std::optional<std::string>(""),
-                                                       std::optional<std::string>("lz4"), std::optional<std::string>("zstd")}) {
+  for (const std::optional<std::string>& compression :
+       {std::optional<std::string>(), std::optional<std::string>(""), std::optional<std::string>("lz4"),
+        std::optional<std::string>("zstd")}) {
     SCOPED_TRACE(compression.value_or("no chunks"));
     McapWriter mcap(compression);
     mcap.schema(1, "sensor_msgs/msg/Imu");
@@ -830,7 +860,8 @@ TEST(Mcap, EventPacketsInChunksOfEveryCompressionOrNone) {
     PacketFields fields;
     for (std::size_t at = 0, seq = 0; at < words.size(); ++seq) {
       const std::size_t size = std::min<std::size_t>(words.size() - at, 2 * (41 + 97 * (seq % 4)));
-      fields.events.assign(words.begin() + static_cast<std::ptrdiff_t>(at), words.begin() + static_cast<std::ptrdiff_t>(at + size));
+      fields.events.assign(words.begin() + static_cast<std::ptrdiff_t>(at),
+                           words.begin() + static_cast<std::ptrdiff_t>(at + size));
       mcap.message(1, seq, std::vector<std::uint8_t>(24, 3));
       mcap.message(2, seq, event_packet_cdr(fields));
       at += size;
@@ -841,7 +872,8 @@ TEST(Mcap, EventPacketsInChunksOfEveryCompressionOrNone) {
     EXPECT_EQ(result.error, "");
     EXPECT_EQ(result.events, events_of(events));
     EXPECT_EQ(result.sensor, (SensorSize{640, 480}));
-    EXPECT_NE(result.name.find("MCAP, /event_camera/events (event_camera_msgs/msg/EventPacket), camera cam-7"), std::string::npos)
+    EXPECT_NE(result.name.find("MCAP, /event_camera/events (event_camera_msgs/msg/EventPacket), camera cam-7"),
+              std::string::npos)
         << result.name;
   }
   try {
@@ -854,7 +886,8 @@ TEST(Mcap, EventPacketsInChunksOfEveryCompressionOrNone) {
     read_all(path, "/nothing");
     ADD_FAILURE() << "no such channel";
   } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find("channels: /imu (sensor_msgs/msg/Imu, cdr), /event_camera/events"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("channels: /imu (sensor_msgs/msg/Imu, cdr), /event_camera/events"),
+              std::string::npos)
         << error.what();
   }
 }
@@ -871,7 +904,7 @@ TEST(Mcap, AMessageOfThePacketFamilyIsReadByItsSchemasDefinition) {
   put32(message, 480);
   put32(message, 640);
   for (int i = 0; i < 16; ++i) message.push_back(0);  // seq, time_base
-  message.push_back(0);                                // is_bigendian
+  message.push_back(0);                               // is_bigendian
   put_string(message, std::string(words.begin(), words.end()));
   McapWriter mcap(std::nullopt);
   mcap.schema(1, "event_array_msgs/EventArray", "ros1msg", kEventArrayFamilyDefinition);
@@ -960,8 +993,10 @@ TEST(Mcap, ImagesOfAChannelBesideTheEvents) {
     open_mcap_images(path, "/events");
     ADD_FAILURE() << "an event channel holds no images";
   } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find("channel /events is of type event_camera_msgs/msg/EventPacket (cdr), not sensor_msgs/msg/Image"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(error.what())
+            .find("channel /events is of type event_camera_msgs/msg/EventPacket (cdr), not sensor_msgs/msg/Image"),
+        std::string::npos)
         << error.what();
   }
 }
@@ -1013,15 +1048,16 @@ TEST(Mcap, CorruptCutOrUnclosedFilesGiveTheEventsBeforeThenAnError) {
 /// HDF5 fixtures written with the HDF5 C library, in the layouts of DSEC, MVSEC and Metavision.
 class Hdf5Writer {
  public:
-  explicit Hdf5Writer(const std::filesystem::path& path) : file_(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT)) {
+  explicit Hdf5Writer(const std::filesystem::path& path)
+      : file_(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT)) {
     EXPECT_GE(file_, 0);
   }
   ~Hdf5Writer() { H5Fclose(file_); }
   void group(const char* name) { H5Gclose(H5Gcreate2(file_, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)); }
   /// A dataset of `dims` rows (x columns) of `file_type` from `data` of `memory_type`, in chunks
   /// through `filter` (0: none).
-  void dataset(const char* name, hid_t file_type, hid_t memory_type, const void* data, std::vector<hsize_t> dims, H5Z_filter_t filter = 0,
-               unsigned filter_flags = H5Z_FLAG_MANDATORY) {
+  void dataset(const char* name, hid_t file_type, hid_t memory_type, const void* data, std::vector<hsize_t> dims,
+               H5Z_filter_t filter = 0, unsigned filter_flags = H5Z_FLAG_MANDATORY) {
     const hid_t space = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
     const hid_t plist = H5Pcreate(H5P_DATASET_CREATE);
     if (filter != 0) {
@@ -1082,7 +1118,8 @@ TEST(Hdf5, DsecColumnsThroughTheBloscPluginInSlabs) {
   const std::int64_t t_offset = 1'500'000'000'000'000;
   EventBatch events;
   for (int i = 0; i < 150'000; ++i) {  // more than two slabs
-    events.push_back(t_offset + 2 * i + 40, static_cast<std::uint16_t>((13 * i) % 640), static_cast<std::uint16_t>((7 * i) % 480), i % 3 ? 1 : -1);
+    events.push_back(t_offset + 2 * i + 40, static_cast<std::uint16_t>((13 * i) % 640),
+                     static_cast<std::uint16_t>((7 * i) % 480), i % 3 ? 1 : -1);
   }
   write_dsec(path, events, t_offset);
   {  // the fixture is blosc-compressed, so the plugin was found and used
@@ -1099,7 +1136,8 @@ TEST(Hdf5, DsecColumnsThroughTheBloscPluginInSlabs) {
   EXPECT_EQ(result.error, "");
   EXPECT_EQ(result.events, events_of(events));
   EXPECT_EQ(result.sensor, (SensorSize{640, 480}));
-  EXPECT_NE(result.name.find("HDF5, /events (columns x, y, t, p, t in us; 640x480 as DSEC's cameras: not in the file)"), std::string::npos)
+  EXPECT_NE(result.name.find("HDF5, /events (columns x, y, t, p, t in us; 640x480 as DSEC's cameras: not in the file)"),
+            std::string::npos)
       << result.name;
 }
 
@@ -1108,7 +1146,8 @@ TEST(Hdf5, MvsecRowsInSecondsEitherCameraAndMetavisionRecords) {
   const auto path = dir.file("mvsec_data.hdf5");
   std::vector<double> left, right;
   for (int i = 0; i < 1000; ++i) {
-    for (const double value : {double(i % 346), double(i % 260), 1'504'645'177.5 + i * 1e-5, i % 2 ? 1.0 : -1.0}) left.push_back(value);
+    for (const double value : {double(i % 346), double(i % 260), 1'504'645'177.5 + i * 1e-5, i % 2 ? 1.0 : -1.0})
+      left.push_back(value);
     for (const double value : {double(i % 200), 3.0, 1'504'645'180.0 + i * 1e-6, 1.0}) right.push_back(value);
   }
   {
@@ -1201,7 +1240,8 @@ TEST(Hdf5, MissingTablesFiltersOrBytesAreClearErrors) {
     EXPECT_LT(cut.events.size(), events.size());
     EXPECT_NE(cut.error.find("odd.h5"), std::string::npos) << cut.error;
   } catch (const std::runtime_error& error) {  // HDF5 refuses to open it: its superblock says how long it is
-    EXPECT_NE(std::string(error.what()).find("odd.h5': HDF5 cannot open it: truncated file"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("odd.h5': HDF5 cannot open it: truncated file"), std::string::npos)
+        << error.what();
   }
 }
 
@@ -1209,7 +1249,8 @@ TEST(Hdf5, MissingTablesFiltersOrBytesAreClearErrors) {
 
 TEST(RealRecordings, EveryFileReadsWithItsEventCountAndSensorSize) {
   const std::filesystem::path real = std::filesystem::path(EVLDT_SOURCE_DIR) / ".." / "shared" / "real";
-  if (!std::filesystem::is_directory(real)) GTEST_SKIP() << "no real recordings at " << real << " (../shared is absent)";
+  if (!std::filesystem::is_directory(real))
+    GTEST_SKIP() << "no real recordings at " << real << " (../shared is absent)";
   struct Expected {
     const char* file;
     std::size_t events;
@@ -1218,12 +1259,12 @@ TEST(RealRecordings, EveryFileReadsWithItsEventCountAndSensorSize) {
   };
   // Counts from the folder's README and its source projects' tests; triggers counted by evldt
   // (the arm bag holds 2078 falling and 2079 rising edges).
-  for (const Expected& expected : {Expected{"dvxplorer_person.aedat4", 111954, {320, 240}, 0},
-                                   Expected{"prophesee640_arm_ros2.db3", 343474, {640, 480}, 4157},
-                                   Expected{"davis_libcaer_rollover_ros2.db3", 334331, {640, 480}, 0},
-                                   Expected{"evt3_trigger_ros2.db3", 82469, {1280, 720}, 2},
-                                   Expected{"gen41_evt3.raw", 219596, {1280, 720}, 0},
-                                   Expected{"gen3_spinner_evt2.raw", 539481, {640, 480}, 0}}) {
+  for (const Expected& expected :
+       {Expected{"dvxplorer_person.aedat4", 111954, {320, 240}, 0},
+        Expected{"prophesee640_arm_ros2.db3", 343474, {640, 480}, 4157},
+        Expected{"davis_libcaer_rollover_ros2.db3", 334331, {640, 480}, 0},
+        Expected{"evt3_trigger_ros2.db3", 82469, {1280, 720}, 2}, Expected{"gen41_evt3.raw", 219596, {1280, 720}, 0},
+        Expected{"gen3_spinner_evt2.raw", 539481, {640, 480}, 0}}) {
     SCOPED_TRACE(expected.file);
     const ReadAll result = read_all(real / expected.file);
     EXPECT_EQ(result.error, "");
@@ -1233,7 +1274,8 @@ TEST(RealRecordings, EveryFileReadsWithItsEventCountAndSensorSize) {
     bool in_order = true, on_sensor = true;
     for (std::size_t i = 0; i < result.events.size(); ++i) {
       in_order = in_order && (i == 0 || result.events[i].t >= result.events[i - 1].t);
-      on_sensor = on_sensor && result.events[i].x < expected.sensor.width && result.events[i].y < expected.sensor.height;
+      on_sensor =
+          on_sensor && result.events[i].x < expected.sensor.width && result.events[i].y < expected.sensor.height;
     }
     EXPECT_TRUE(in_order);
     EXPECT_TRUE(on_sensor);

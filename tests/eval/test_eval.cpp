@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "eval/reference_matching.hpp"
 #include "evldt/eval/accumulator.hpp"
 #include "evldt/eval/line_heatmap.hpp"
 #include "evldt/eval/plots.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/eval/whole_line_support.hpp"
 #include "evldt/sim/scenes.hpp"
-#include "eval/reference_matching.hpp"
 
 namespace evldt {
 namespace {
@@ -300,7 +300,8 @@ GroundTruthSteps moving_truth() {
 }
 
 StreamEvaluator moving_evaluator() {
-  return StreamEvaluator(kSensor, {0.01, 0.02}, moving_truth(), std::llround(StreamEvaluator::kHoldPeriods * kGtPeriod));
+  return StreamEvaluator(kSensor, {0.01, 0.02}, moving_truth(),
+                         std::llround(StreamEvaluator::kHoldPeriods * kGtPeriod));
 }
 
 void predict(StreamEvaluator& evaluator, Timestamp t, std::uint64_t id, std::vector<Segment> segments) {
@@ -339,8 +340,10 @@ TEST(StreamEvaluator, OneStepOfPredictionIsHeldForOnePeriodAndRecallIsOverAllSte
 
 // Speeds along a piece are linear between its ends: the part below the threshold either way is hidden.
 TEST(SplitByNormalSpeed, HidesThePartOfAPieceMovingSlowerThanTheThreshold) {
-  const std::vector<Segment> truth = {{Point2(0, 0), Point2(100, 0)}, {Point2(0, 10), Point2(100, 10)},
-                                      {Point2(0, 20), Point2(100, 20)}, {Point2(0, 30), Point2(100, 30)}};
+  const std::vector<Segment> truth = {{Point2(0, 0), Point2(100, 0)},
+                                      {Point2(0, 10), Point2(100, 10)},
+                                      {Point2(0, 20), Point2(100, 20)},
+                                      {Point2(0, 30), Point2(100, 30)}};
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const std::vector<float> at_q0 = {-4, 1, 5, nan}, at_q1 = {4, -1, 3, 0};
   std::vector<Segment> visible, hidden;
@@ -363,7 +366,9 @@ TEST(SplitByNormalSpeed, HidesThePartOfAPieceMovingSlowerThanTheThreshold) {
 // Two true lines, one moving across itself and one along itself (no events): the second and what is
 // predicted on it are left out of the visible score; a prediction on neither still counts against.
 TEST(StreamEvaluator, VisibleOnlyLeavesOutAnEdgeMovingAlongItselfAndWhatIsPredictedOnIt) {
-  const auto along_itself = [](std::size_t step) { return row_segment(40, 10 + static_cast<int>(step), 50 + static_cast<int>(step)); };
+  const auto along_itself = [](std::size_t step) {
+    return row_segment(40, 10 + static_cast<int>(step), 50 + static_cast<int>(step));
+  };
   GroundTruthSteps truth = moving_truth();
   truth.segments_at = [&](std::size_t index, std::vector<Segment>& segments, std::vector<std::uint64_t>& ids) {
     segments = {moving_line(index), along_itself(index)};
@@ -375,7 +380,8 @@ TEST(StreamEvaluator, VisibleOnlyLeavesOutAnEdgeMovingAlongItselfAndWhatIsPredic
     evaluator.score_visible_only(VisibleOnly::by_speed(2.0f));
     for (int k = 0; k < kGtSteps; ++k) {
       const auto index = static_cast<std::size_t>(k);
-      predict(evaluator, k * kGtPeriod, 1, {moving_line(index), off_edge ? row_segment(70, 10, 50) : along_itself(index)});
+      predict(evaluator, k * kGtPeriod, 1,
+              {moving_line(index), off_edge ? row_segment(70, 10, 50) : along_itself(index)});
     }
     evaluator.finish();
     const Prf full = evaluator.accuracy().summed_prf(0);
@@ -516,7 +522,8 @@ TEST(StreamEvaluator, APredictionThatLagsOnePeriodIsScoredAgainstTheTruthOfItsSt
 
   // Stamped half a period late instead (t + 5 shows the truth of t): each step sees the one before.
   StreamEvaluator half_late = moving_evaluator();
-  for (int k = 0; k < kGtSteps; ++k) predict(half_late, k * kGtPeriod + 5, 7, {moving_line(static_cast<std::size_t>(k))});
+  for (int k = 0; k < kGtSteps; ++k)
+    predict(half_late, k * kGtPeriod + 5, 7, {moving_line(static_cast<std::size_t>(k))});
   half_late.finish();
   EXPECT_EQ(half_late.accuracy().total(0), expected_tight);
   EXPECT_EQ(half_late.accuracy().total(1), expected_loose);
@@ -541,7 +548,7 @@ TEST(StreamEvaluator, PredictionsOutsideTheGroundTruthRangeAreCountedNotScored) 
 TEST(StreamEvaluator, AStallInsideTheStreamCostsRecallAndTimeMayNotGoBack) {
   StreamEvaluator evaluator = moving_evaluator();
   predict(evaluator, 0, 1, {moving_line(0)});
-  predict(evaluator, 0, 1, {moving_line(0)});  // the same time again replaces the step
+  predict(evaluator, 0, 1, {moving_line(0)});   // the same time again replaces the step
   predict(evaluator, 40, 1, {moving_line(4)});  // nothing for 10, 20, 30: a stall
   EXPECT_THROW(predict(evaluator, 39, 1, {}), std::invalid_argument);
   evaluator.finish();
@@ -675,7 +682,7 @@ TEST(NoiseFilters, KeepTheAccuracyOfACleanSceneAndRecoverMostOfANoisyOnes) {
 }
 
 TEST(WholeLineSupport, CountsTheLengthNearASegmentAndTheWeakLines) {
-  WholeLineSupport support;  // 2 px, weak below 60%
+  WholeLineSupport support;                                       // 2 px, weak below 60%
   const Segment left{{0, 0}, {40, 0}}, right{{60, 1}, {100, 1}};  // two collinear edges, a 20 px gap
   // A whole line on the left edge alone, and one bridging the gap to the right edge.
   const std::vector<Segment> whole{{{0, 0}, {40, 0}}, {{0, 0.5f}, {100, 0.5f}}};
@@ -701,7 +708,6 @@ TEST(WholeLineSupport, CountsTheLengthNearASegmentAndTheWeakLines) {
   EXPECT_THROW(WholeLineSupport(-1.0f), std::invalid_argument);
   EXPECT_THROW(WholeLineSupport(2.0f, 1.5f), std::invalid_argument);
 }
-
 
 // Recall per true edge (--edge-recall): a line moving down 2 px a step, found at every step, and a
 // still one 30-20 px below it, never found.
@@ -755,7 +761,9 @@ TEST(EdgeRecall, CountsEachEdgesPixelsAndMatchesWithItsSpeedAndParallelGap) {
   EXPECT_EQ(picture->truth.size(), 2u);
   ASSERT_EQ(picture->predicted.size(), 1u);
   EXPECT_EQ(picture->predicted[0].q0, moving_line(2).q0);
-  const auto matched_at = [&](int x, int y) { return picture->matched_map[static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)]; };
+  const auto matched_at = [&](int x, int y) {
+    return picture->matched_map[static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)];
+  };
   EXPECT_EQ(matched_at(20, 14), 1);  // on the found line (y = 10 + 2 * 2)
   EXPECT_EQ(matched_at(20, 40), 0);  // on the missed one
   const auto path = std::filesystem::temp_directory_path() / "evldt_edge_recall_test.png";

@@ -63,7 +63,8 @@ void write_file(const fs::path& path, EventFormat format, const std::vector<Even
   const std::size_t per_batch = (events.size() + batches - 1) / batches;
   for (std::size_t start = 0; start < events.size(); start += per_batch) {
     const auto end = std::min(events.size(), start + per_batch);
-    writer.write(batch_of({events.begin() + static_cast<std::ptrdiff_t>(start), events.begin() + static_cast<std::ptrdiff_t>(end)}));
+    writer.write(batch_of(
+        {events.begin() + static_cast<std::ptrdiff_t>(start), events.begin() + static_cast<std::ptrdiff_t>(end)}));
   }
   writer.close();
 }
@@ -149,7 +150,8 @@ TEST(EventBatchAppender, AppendsAfterTheEventsThereAsPushBackWouldAcrossBlocks) 
   {
     EventBatch::Appender out(batch);
     for (int i = 0; i < 5000; ++i) {
-      const Event e{i, static_cast<std::uint16_t>(i % 1280), static_cast<std::uint16_t>(i % 720), i % 3 ? std::int8_t{1} : std::int8_t{-1}};
+      const Event e{i, static_cast<std::uint16_t>(i % 1280), static_cast<std::uint16_t>(i % 720),
+                    i % 3 ? std::int8_t{1} : std::int8_t{-1}};
       out.push_back(e);
       expected.push_back(e);
     }
@@ -197,7 +199,8 @@ TEST(EventBatch, ReserveTouchedEmptiesItWithRoomThatDoesNotMove) {
 // Names
 
 TEST(EventFormat, ParsesNamesAndPrintsThemBack) {
-  for (const EventFormat format : {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat}) {
+  for (const EventFormat format :
+       {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat}) {
     EXPECT_EQ(parse_event_format(format_name(format)), format);
   }
   EXPECT_EQ(parse_event_format("evt3"), EventFormat::Evt3);
@@ -266,7 +269,8 @@ TEST(RoundTripEdges, EvtFormatsCrossLongGapsAndTheirOwnWraps) {
 
 TEST(RoundTripEdges, EmptyRecordingHasHeaderOnly) {
   TempDir dir;
-  for (const EventFormat format : {EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat, EventFormat::EcdText}) {
+  for (const EventFormat format :
+       {EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat, EventFormat::EcdText}) {
     SCOPED_TRACE(std::string(format_name(format)));
     const fs::path path = dir.file("empty.bin");
     write_file(path, format, {});
@@ -284,7 +288,8 @@ TEST(RoundTripEdges, EmptyRecordingHasHeaderOnly) {
 
 TEST(Header, GeometryComesFromAnyOfTheHeaderForms) {
   std::optional<SensorSize> geometry;
-  decode_in_chunks(EventFormat::Evt3, bytes_of("% camera_integrator_name Prophesee\n% format EVT3;height=720;width=1280\n% end\n"), 5,
+  decode_in_chunks(EventFormat::Evt3,
+                   bytes_of("% camera_integrator_name Prophesee\n% format EVT3;height=720;width=1280\n% end\n"), 5,
                    &geometry);
   EXPECT_EQ(geometry, (SensorSize{1280, 720}));
 
@@ -307,7 +312,8 @@ TEST(Header, WriterHeaderNamesEncodingAndGeometry) {
   const fs::path path = dir.file("header.raw");
   write_file(path, EventFormat::Evt3, {});
   const auto bytes = read_bytes(path);
-  EXPECT_EQ(std::string(bytes.begin(), bytes.end()), "% evt 3.0\n% format EVT3;height=720;width=1280\n% geometry 1280x720\n% end\n");
+  EXPECT_EQ(std::string(bytes.begin(), bytes.end()),
+            "% evt 3.0\n% format EVT3;height=720;width=1280\n% geometry 1280x720\n% end\n");
 }
 
 TEST(Header, RawFileFormatIsTakenFromTheHeaderOrRefused) {
@@ -353,7 +359,7 @@ TEST(Evt2, DecodesHandWrittenWords) {
   append_le32(bytes, (0xFu << 28) | 0x7u);                              // CONTINUED: skipped
   append_le32(bytes, (0x8u << 28) | 0x0FFFFFFFu);                       // last TIME_HIGH before the 2^34 us wrap
   append_le32(bytes, (0x1u << 28) | (63u << 22) | (2047u << 11) | 2047u);
-  append_le32(bytes, (0x8u << 28) | 1u);                                // wrapped
+  append_le32(bytes, (0x8u << 28) | 1u);  // wrapped
   append_le32(bytes, (0x0u << 28) | (9u << 22) | (10u << 11) | 11u);
   const std::vector<Event> expected{{5, 100, 200, 1},
                                     {3 * 64 + 7, 1, 2, -1},
@@ -366,15 +372,15 @@ TEST(Evt2, DecodesHandWrittenWords) {
 
 TEST(Evt3, DecodesHandWrittenWordsWithVectorsAndTimeWrap) {
   std::vector<std::uint8_t> bytes;  // no header: the data may start right away
-  append_le16(bytes, 0x2805);  // EVT_ADDR_X before any time: dropped
-  append_le16(bytes, 0x8001);  // TIME_HIGH 1 -> 4096 us
-  append_le16(bytes, 0x6010);  // TIME_LOW 16 -> 4112 us
-  append_le16(bytes, 0x000A);  // EVT_ADDR_Y 10
-  append_le16(bytes, 0x2805);  // EVT_ADDR_X polarity 1, x 5
-  append_le16(bytes, 0x3064);  // VECT_BASE_X polarity 0, x 100
-  append_le16(bytes, 0x4805);  // VECT_12 bits 0, 2, 11 -> x 100, 102, 111; base -> 112
-  append_le16(bytes, 0x5081);  // VECT_8 bits 0, 7 -> x 112, 119; base -> 120
-  append_le16(bytes, 0x7123);  // CONTINUED_4, EXT_TRIGGER, OTHERS, CONTINUED_12: skipped
+  append_le16(bytes, 0x2805);       // EVT_ADDR_X before any time: dropped
+  append_le16(bytes, 0x8001);       // TIME_HIGH 1 -> 4096 us
+  append_le16(bytes, 0x6010);       // TIME_LOW 16 -> 4112 us
+  append_le16(bytes, 0x000A);       // EVT_ADDR_Y 10
+  append_le16(bytes, 0x2805);       // EVT_ADDR_X polarity 1, x 5
+  append_le16(bytes, 0x3064);       // VECT_BASE_X polarity 0, x 100
+  append_le16(bytes, 0x4805);       // VECT_12 bits 0, 2, 11 -> x 100, 102, 111; base -> 112
+  append_le16(bytes, 0x5081);       // VECT_8 bits 0, 7 -> x 112, 119; base -> 120
+  append_le16(bytes, 0x7123);       // CONTINUED_4, EXT_TRIGGER, OTHERS, CONTINUED_12: skipped
   append_le16(bytes, 0xA001);
   append_le16(bytes, 0xE014);
   append_le16(bytes, 0xF456);
@@ -388,8 +394,8 @@ TEST(Evt3, DecodesHandWrittenWordsWithVectorsAndTimeWrap) {
   append_le16(bytes, 0x2801);  // EVT_ADDR_X polarity 1, x 1
   const Timestamp before_wrap = (Timestamp{0xFFF} << 12) + 5;
   const Timestamp after_wrap = k2Pow24 + (Timestamp{2} << 12) + 3;
-  const std::vector<Event> expected{{4112, 5, 10, 1},    {4112, 100, 10, -1}, {4112, 102, 10, -1},
-                                    {4112, 111, 10, -1}, {4112, 112, 10, -1}, {4112, 119, 10, -1},
+  const std::vector<Event> expected{{4112, 5, 10, 1},    {4112, 100, 10, -1},      {4112, 102, 10, -1},
+                                    {4112, 111, 10, -1}, {4112, 112, 10, -1},      {4112, 119, 10, -1},
                                     {4112, 121, 10, -1}, {before_wrap, 7, 10, -1}, {after_wrap, 1, 20, 1}};
   for (const std::size_t chunk : {std::size_t{1}, std::size_t{3}, bytes.size()}) {
     EXPECT_EQ(decode_in_chunks(EventFormat::Evt3, bytes, chunk), expected) << "chunk " << chunk;
@@ -402,22 +408,28 @@ TEST(Evt3, DecodesHandWrittenWordsWithVectorsAndTimeWrap) {
 TEST(EcdText, ConvertsDecimalSecondsToExactMicroseconds) {
   const std::string text =
       "# t x y p\n"
-      "0.0000015 1 2 1\n"    // 1.5 us rounds half up
+      "0.0000015 1 2 1\n"  // 1.5 us rounds half up
       "0.0000014999 1 2 1\r\n"
       "\n"
       "12.5 3 4 0\n"
       "1 0 0 1\n"
       "0.003811000 5 6 0\n"
-      "0.9999995 7 8 1\n"   // the rounding carries into the seconds
+      "0.9999995 7 8 1\n"  // the rounding carries into the seconds
       "   \t\n"
       "4294.967296123 65535 65535 0\n"
-      "  3.5 11 12 1 \t\n"              // blanks before and after
-      "3.6 0000000000013 007 0\n"        // leading zeros, past the plain line's nine digits
-      "2.000001\t9  10 1";  // last line without '\n'
-  const std::vector<Event> expected{{2, 1, 2, 1},         {1, 1, 2, 1},        {12'500'000, 3, 4, -1},
-                                    {1'000'000, 0, 0, 1}, {3811, 5, 6, -1},    {1'000'000, 7, 8, 1},
-                                    {4'294'967'296, 65535, 65535, -1}, {3'500'000, 11, 12, 1},
-                                    {3'600'000, 13, 7, -1}, {2'000'001, 9, 10, 1}};
+      "  3.5 11 12 1 \t\n"         // blanks before and after
+      "3.6 0000000000013 007 0\n"  // leading zeros, past the plain line's nine digits
+      "2.000001\t9  10 1";         // last line without '\n'
+  const std::vector<Event> expected{{2, 1, 2, 1},
+                                    {1, 1, 2, 1},
+                                    {12'500'000, 3, 4, -1},
+                                    {1'000'000, 0, 0, 1},
+                                    {3811, 5, 6, -1},
+                                    {1'000'000, 7, 8, 1},
+                                    {4'294'967'296, 65535, 65535, -1},
+                                    {3'500'000, 11, 12, 1},
+                                    {3'600'000, 13, 7, -1},
+                                    {2'000'001, 9, 10, 1}};
   for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, text.size()}) {
     EXPECT_EQ(decode_in_chunks(EventFormat::EcdText, bytes_of(text), chunk), expected) << "chunk " << chunk;
   }
@@ -428,19 +440,21 @@ TEST(EcdText, WriterPrintsSecondsWithNineFractionDigits) {
   const fs::path path = dir.file("events.txt");
   write_file(path, EventFormat::EcdText, {{3811, 5, 6, -1}, {12'500'000, 640, 480, 1}, {k2Pow32, 0, 0, 1}}, 1);
   const auto bytes = read_bytes(path);
-  EXPECT_EQ(std::string(bytes.begin(), bytes.end()), "0.003811000 5 6 0\n12.500000000 640 480 1\n4294.967296000 0 0 1\n");
+  EXPECT_EQ(std::string(bytes.begin(), bytes.end()),
+            "0.003811000 5 6 0\n12.500000000 640 480 1\n4294.967296000 0 0 1\n");
 }
 
 TEST(EcdText, MalformedLinesAreReportedAtTheirStartWithTheirNumber) {
   const std::string good = "0.1 1 2 1\n";  // 10 bytes
-  for (const std::string bad : {"0.2 abc 3 0", "0.2 1 2", "0.2 1 2 2", "0.2 -1 2 1", "0.2 1 65536 1", "0.2 1 2 1 junk",
-                                "-0.2 1 2 1", "0.2e3 1 2 1", "0.2. 1 2 1", ". 1 2 1", "0,2 1 2 1", "0.2 1 2 10",
-                                "0.2 1 2 1x", "0.2 1 2 +1", "0.2 1 2 1 0", "0.2 1 0065536 1", "0. 1 2 1",
-                                "1234567890123 1 2 1", "88888888888888888888888888.5 1 2 1"}) {
+  for (const std::string bad :
+       {"0.2 abc 3 0", "0.2 1 2", "0.2 1 2 2", "0.2 -1 2 1", "0.2 1 65536 1", "0.2 1 2 1 junk", "-0.2 1 2 1",
+        "0.2e3 1 2 1", "0.2. 1 2 1", ". 1 2 1", "0,2 1 2 1", "0.2 1 2 10", "0.2 1 2 1x", "0.2 1 2 +1", "0.2 1 2 1 0",
+        "0.2 1 0065536 1", "0. 1 2 1", "1234567890123 1 2 1", "88888888888888888888888888.5 1 2 1"}) {
     SCOPED_TRACE(bad);
     EventBatch batch;
     const auto decoder = make_decoder(EventFormat::EcdText, "events.txt");
-    const FormatError error = expect_format_error([&] { decoder->decode(bytes_of(good + bad + "\n0.3 1 1 1\n"), batch); });
+    const FormatError error =
+        expect_format_error([&] { decoder->decode(bytes_of(good + bad + "\n0.3 1 1 1\n"), batch); });
     EXPECT_EQ(events_of(batch), (std::vector<Event>{{100000, 1, 2, 1}}));
     EXPECT_EQ(error.byte_offset(), good.size());
     EXPECT_NE(std::string(error.what()).find("line 2"), std::string::npos) << error.what();
@@ -483,14 +497,27 @@ TEST_P(Truncated, DeliversEveryEventBeforeTheCutThenReportsItsOffset) {
       partial_start = std::string(bytes.begin(), bytes.end()).rfind('\n', bytes.size() - 2) + 1;
       bytes.resize(bytes.size() - 3);  // drops " p\n": the line ends after y
       break;
-    case EventFormat::Evt2: partial_start = bytes.size() - 4; bytes.resize(bytes.size() - 1); break;
-    case EventFormat::Evt3: partial_start = bytes.size() - 2; bytes.resize(bytes.size() - 1); break;
-    case EventFormat::Evt21: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 3); break;
-    case EventFormat::Dat: partial_start = bytes.size() - 8; bytes.resize(bytes.size() - 5); break;
+    case EventFormat::Evt2:
+      partial_start = bytes.size() - 4;
+      bytes.resize(bytes.size() - 1);
+      break;
+    case EventFormat::Evt3:
+      partial_start = bytes.size() - 2;
+      bytes.resize(bytes.size() - 1);
+      break;
+    case EventFormat::Evt21:
+      partial_start = bytes.size() - 8;
+      bytes.resize(bytes.size() - 3);
+      break;
+    case EventFormat::Dat:
+      partial_start = bytes.size() - 8;
+      bytes.resize(bytes.size() - 5);
+      break;
     case EventFormat::Aedat2:
     case EventFormat::Aedat31:
     case EventFormat::Aedat31Network:
-    case EventFormat::EventStream: FAIL() << "evldt does not write " << format_name(format);
+    case EventFormat::EventStream:
+      FAIL() << "evldt does not write " << format_name(format);
   }
   write_bytes(path, bytes);
   const std::vector<Event> before_cut(written.begin(), written.end() - 1);
@@ -554,7 +581,8 @@ TEST(RawQuirks, Evt3PaddingAndReservedWordsAreSkippedAndCountedInAnyChunking) {
   auto bytes = bytes_of("% evt 3.0\n% end\n");
   // TIME_HIGH 0, y 3, x 4, then IMX636-style 0x9999 padding and the other reserved types, a
   // trigger, and x 5.
-  for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x8000, 0x0003, 0x2804, 0x9999, 0x9999, 0x1000, 0xB000, 0xC000, 0xD000, 0xA001, 0x2805}) {
+  for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x8000, 0x0003, 0x2804, 0x9999, 0x9999, 0x1000,
+                                                                       0xB000, 0xC000, 0xD000, 0xA001, 0x2805}) {
     append_le16(bytes, word);
   }
   write_bytes(path, bytes);
@@ -574,15 +602,16 @@ TEST(RawQuirks, Evt3PaddingAndReservedWordsAreSkippedAndCountedInAnyChunking) {
 // the order the header names, or (without one) the order of the camera's system id.
 TEST(RawQuirks, Evt21VectorsInEitherHalfOrder) {
   const std::uint64_t time_high = std::uint64_t{0x8} << 60 | std::uint64_t{1} << 32;  // time bits 6.. = 1: 64 us
-  const std::uint64_t vector = std::uint64_t{0x1} << 60 | std::uint64_t{5} << 54 | std::uint64_t{32} << 43 |
-                               std::uint64_t{7} << 32 | 0b1011u;
+  const std::uint64_t vector =
+      std::uint64_t{0x1} << 60 | std::uint64_t{5} << 54 | std::uint64_t{32} << 43 | std::uint64_t{7} << 32 | 0b1011u;
   const std::uint64_t before_time = std::uint64_t{0x0} << 60 | std::uint64_t{3} << 32 | 1u;  // no time yet: dropped
   const std::uint64_t reserved = std::uint64_t{0x3} << 60, trigger = std::uint64_t{0xA} << 60 | std::uint64_t{1} << 32;
   const std::vector<Event> expected{{69, 32, 7, 1}, {69, 33, 7, 1}, {69, 35, 7, 1}};
-  for (const auto& [header, legacy] : {std::pair{"% evt 2.1\n% system_ID 49\n% end\n", true},
-                                       std::pair{"% format EVT21;endianness=little;height=720;width=1280\n% end\n", false},
-                                       std::pair{"% format EVT21;endianness=legacy\n% end\n", true},
-                                       std::pair{"% format EVT21;height=320;width=320\n% end\n", false}}) {
+  for (const auto& [header, legacy] :
+       {std::pair{"% evt 2.1\n% system_ID 49\n% end\n", true},
+        std::pair{"% format EVT21;endianness=little;height=720;width=1280\n% end\n", false},
+        std::pair{"% format EVT21;endianness=legacy\n% end\n", true},
+        std::pair{"% format EVT21;height=320;width=320\n% end\n", false}}) {
     SCOPED_TRACE(header);
     auto bytes = bytes_of(header);
     for (const std::uint64_t word : {before_time, time_high, reserved, vector, trigger}) {
@@ -615,7 +644,8 @@ void append_aedat3_packet_header(std::vector<std::uint8_t>& bytes, std::uint16_t
   for (const std::uint32_t value : {event_size, 4u, overflow, count, count, count}) append_le32(bytes, value);
 }
 
-void append_polarity(std::vector<std::uint8_t>& bytes, std::uint32_t x, std::uint32_t y, bool on, std::uint32_t t, bool valid = true) {
+void append_polarity(std::vector<std::uint8_t>& bytes, std::uint32_t x, std::uint32_t y, bool on, std::uint32_t t,
+                     bool valid = true) {
   append_le32(bytes, x << 17 | y << 2 | (on ? 2u : 0u) | (valid ? 1u : 0u));
   append_le32(bytes, t);
 }
@@ -623,8 +653,9 @@ void append_polarity(std::vector<std::uint8_t>& bytes, std::uint32_t x, std::uin
 TEST(Aedat, Aedat31PolarityPacketsWithTheirOverflowOtherPacketsSkipped) {
   TempDir dir;
   const fs::path path = dir.file("davis.aedat");
-  auto bytes = bytes_of("#!AER-DAT3.1\r\n#Format: RAW\r\n#Source 1: DAVIS346B\r\n#Start-Time: 2017-06-07 10:00:00 (TZ+0200)\r\n"
-                        "#!END-HEADER\r\n");
+  auto bytes = bytes_of(
+      "#!AER-DAT3.1\r\n#Format: RAW\r\n#Source 1: DAVIS346B\r\n#Start-Time: 2017-06-07 10:00:00 (TZ+0200)\r\n"
+      "#!END-HEADER\r\n");
   append_aedat3_packet_header(bytes, 1, 8, 0, 3);
   append_polarity(bytes, 5, 7, true, 100);
   append_polarity(bytes, 6, 7, true, 150, /*valid=*/false);
@@ -665,7 +696,7 @@ void append_aedat3_network_header(std::vector<std::uint8_t>& bytes, std::uint8_t
   append_le32(bytes, 0);  // sequence number
   append_le32(bytes, 0);
   bytes.push_back(version);
-  bytes.push_back(0);  // format
+  bytes.push_back(0);     // format
   append_le16(bytes, 1);  // source id
 }
 
@@ -709,8 +740,9 @@ TEST(Aedat, Aedat31NetworkStreamIsRecognisedByItsMagicAndDecodedAsTheFilesPacket
 TEST(Aedat, Aedat2AddressesOfDavisAndDvs128ChipsMirroredToATopLeftOrigin) {
   TempDir dir;
   const fs::path path = dir.file("rec.aedat");
-  auto davis = bytes_of("#!AER-DAT2.0\r\n# This is a raw AE data file\r\n# AEChip: eu.seebetter.ini.chips.davis.DAVIS240C\r\n"
-                        "#End Of ASCII Header\r\n");
+  auto davis = bytes_of(
+      "#!AER-DAT2.0\r\n# This is a raw AE data file\r\n# AEChip: eu.seebetter.ini.chips.davis.DAVIS240C\r\n"
+      "#End Of ASCII Header\r\n");
   auto record = [](std::vector<std::uint8_t>& bytes, std::uint32_t address, std::uint32_t t) {
     append_be32(bytes, address);
     append_be32(bytes, t);
@@ -731,8 +763,8 @@ TEST(Aedat, Aedat2AddressesOfDavisAndDvs128ChipsMirroredToATopLeftOrigin) {
   EXPECT_EQ(reader.counts(), (DecodeCounts{1, 1}));
 
   auto dvs128 = bytes_of("#!AER-DAT2.0\r\n# created 2008\r\n");  // no chip line: a DVS128
-  record(dvs128, 4u << 8 | 3u << 1 | 0u, 7);  // raw (3, 4), polarity bit 0: ON
-  record(dvs128, 0x8000u, 8);                 // an external event
+  record(dvs128, 4u << 8 | 3u << 1 | 0u, 7);                     // raw (3, 4), polarity bit 0: ON
+  record(dvs128, 0x8000u, 8);                                    // an external event
   record(dvs128, 127u << 8 | 0u << 1 | 1u, 9);
   write_bytes(path, dvs128);
   EXPECT_EQ(EventStreamReader(path).geometry(), (SensorSize{128, 128}));
@@ -756,11 +788,11 @@ TEST(EventStream, DvsAndAtisEventsWithTheirTimeDeltas) {
     append_le16(bytes, y);
   };
   auto dvs = header(1);
-  dvs.push_back(0xFF);            // t += 127
-  dvs.push_back(10 << 1 | 1);     // t += 10: ON
-  coordinates(dvs, 3, 0);         // bottom row
-  dvs.push_back(0xFE);            // reset: nothing
-  dvs.push_back(0 << 1 | 0);      // same time, OFF
+  dvs.push_back(0xFF);         // t += 127
+  dvs.push_back(10 << 1 | 1);  // t += 10: ON
+  coordinates(dvs, 3, 0);      // bottom row
+  dvs.push_back(0xFE);         // reset: nothing
+  dvs.push_back(0 << 1 | 0);   // same time, OFF
   coordinates(dvs, 303, 239);
   write_bytes(path, dvs);
   EXPECT_EQ(EventStreamReader(path, std::nullopt, 3).format(), EventFormat::EventStream);
@@ -770,10 +802,10 @@ TEST(EventStream, DvsAndAtisEventsWithTheirTimeDeltas) {
   }
 
   auto atis = header(2);
-  atis.push_back(0xFE);            // t += 63 * 2
-  atis.push_back(5 << 2 | 2);      // t += 5: a change detection, ON
+  atis.push_back(0xFE);        // t += 63 * 2
+  atis.push_back(5 << 2 | 2);  // t += 5: a change detection, ON
   coordinates(atis, 7, 8);
-  atis.push_back(1 << 2 | 1);      // t += 1: a threshold crossing, skipped
+  atis.push_back(1 << 2 | 1);  // t += 1: a threshold crossing, skipped
   coordinates(atis, 7, 8);
   write_bytes(path, atis);
   EXPECT_EQ(read_file(path, std::nullopt, 2).events, (std::vector<Event>{{131, 7, 231, 1}}));
@@ -788,7 +820,8 @@ TEST(EventStream, DvsAndAtisEventsWithTheirTimeDeltas) {
 TEST(RawQuirks, BareWordsHaveNoHeaderEvenWhenTheyStartWithAPercentByte) {
   // 0x0025 is EVT_ADDR_Y 37, whose first byte is '%'.
   std::vector<std::uint8_t> bytes;
-  for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x8000, 0x0025, 0x2804}) append_le16(bytes, word);
+  for (const std::uint16_t word : std::initializer_list<std::uint16_t>{0x8000, 0x0025, 0x2804})
+    append_le16(bytes, word);
   bytes.insert(bytes.begin(), {0x25, 0x00});  // y = 37 first
   EventBatch batch;
   const auto decoder = detail::make_evt3_decoder("packet", RawFraming::BareWords);
@@ -855,17 +888,19 @@ TEST(Reader, UnknownExtensionNeedsAnExplicitFormat) {
 
 TEST(Writer, RejectsTimeGoingBackwardsAndKeepsWhatWasWritten) {
   TempDir dir;
-  for (const EventFormat format : {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat}) {
+  for (const EventFormat format :
+       {EventFormat::EcdText, EventFormat::Evt2, EventFormat::Evt3, EventFormat::Evt21, EventFormat::Dat}) {
     SCOPED_TRACE(std::string(format_name(format)));
     const fs::path path = dir.file("backwards.bin");
     EventWriter writer(path, format, kSensor);
     writer.write(batch_of({{100, 1, 1, 1}, {100, 2, 2, -1}}));
     EXPECT_THROW(writer.write(batch_of({{150, 1, 1, 1}, {120, 1, 1, 1}})), std::invalid_argument);  // within a batch
-    EXPECT_THROW(writer.write(batch_of({{99, 1, 1, 1}})), std::invalid_argument);                  // across batches
+    EXPECT_THROW(writer.write(batch_of({{99, 1, 1, 1}})), std::invalid_argument);                   // across batches
     EXPECT_THROW(writer.write(batch_of({{-1, 1, 1, 1}})), std::invalid_argument);
     writer.write(batch_of({{101, 3, 3, 1}}));
     writer.close();
-    EXPECT_EQ(read_file(path, format, kOneMiB).events, (std::vector<Event>{{100, 1, 1, 1}, {100, 2, 2, -1}, {101, 3, 3, 1}}));
+    EXPECT_EQ(read_file(path, format, kOneMiB).events,
+              (std::vector<Event>{{100, 1, 1, 1}, {100, 2, 2, -1}, {101, 3, 3, 1}}));
   }
 }
 

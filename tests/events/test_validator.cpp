@@ -13,10 +13,10 @@ TEST(EventValidator, DropsOffSensorAndBackwardsEventsAndKeepsOrder) {
   EventValidator validator({10, 8}, /*backwards_slack_us=*/5);
   EventBatch batch;
   batch.push_back(100, 1, 1, 1);
-  batch.push_back(101, 10, 1, 1);   // x == width: off
-  batch.push_back(102, 2, 8, -1);   // y == height: off
-  batch.push_back(96, 3, 3, -1);    // 5 us back: within slack
-  batch.push_back(94, 4, 4, 1);     // 6 us back: dropped
+  batch.push_back(101, 10, 1, 1);  // x == width: off
+  batch.push_back(102, 2, 8, -1);  // y == height: off
+  batch.push_back(96, 3, 3, -1);   // 5 us back: within slack
+  batch.push_back(94, 4, 4, 1);    // 6 us back: dropped
   batch.push_back(110, 9, 7, 1);
   EXPECT_EQ(validator.filter(batch), 3u);
   ASSERT_EQ(batch.size(), 3u);
@@ -129,13 +129,27 @@ EventBatch faulty_batch(std::mt19937_64& random, Timestamp& t, SensorSize sensor
     Timestamp event_t = t;
     if (unit(random) < fault_rate) {
       switch (kind(random)) {
-        case 0: x = static_cast<std::uint16_t>(std::max(sensor.width, 0) + coordinate(3)); break;
-        case 1: y = 65535; break;
-        case 2: event_t = t - std::uniform_int_distribution<Timestamp>(0, 8)(random); break;  // around the slack
-        case 3: event_t = t - 1000; break;
-        case 4: t += 100'000; break;  // the clock jumps: the next kClockResetRun events fall behind it
-        case 5: t -= 100'000; event_t = t; break;  // the clock goes back
-        default: break;
+        case 0:
+          x = static_cast<std::uint16_t>(std::max(sensor.width, 0) + coordinate(3));
+          break;
+        case 1:
+          y = 65535;
+          break;
+        case 2:
+          event_t = t - std::uniform_int_distribution<Timestamp>(0, 8)(random);
+          break;  // around the slack
+        case 3:
+          event_t = t - 1000;
+          break;
+        case 4:
+          t += 100'000;
+          break;  // the clock jumps: the next kClockResetRun events fall behind it
+        case 5:
+          t -= 100'000;
+          event_t = t;
+          break;  // the clock goes back
+        default:
+          break;
       }
     }
     batch.push_back(event_t, x, y, unit(random) < 0.5 ? std::int8_t{1} : std::int8_t{-1});
@@ -149,7 +163,8 @@ TEST(EventValidator, FastPathKeepsExactlyWhatTheEventByEventRulesKeep) {
   for (const SensorSize sensor : sensors) {
     for (const Timestamp slack : {Timestamp{0}, Timestamp{5}, Timestamp{-3}}) {
       for (const double fault_rate : {0.0, 0.0005, 0.02, 0.5}) {
-        SCOPED_TRACE(testing::Message() << sensor.width << "x" << sensor.height << " slack " << slack << " faults " << fault_rate);
+        SCOPED_TRACE(testing::Message() << sensor.width << "x" << sensor.height << " slack " << slack << " faults "
+                                        << fault_rate);
         EventValidator validator(sensor, slack);
         ReferenceValidator reference(sensor, slack);
         Timestamp t = 1'000'000;

@@ -31,21 +31,26 @@ TrackedLine line(std::uint64_t id, float x0, float y0, float x1, float y1, LineS
 }
 
 TEST(ImageAnnotations, ALineListPerStatusColourScaledAndIdsAtTheCentres) {
-  const std::vector<TrackedLine> lines = {line(7, 1, 2, 11, 2, LineStatus::GoodTrack), line(9, 0, 0, 0, 4, LineStatus::BadTrack),
+  const std::vector<TrackedLine> lines = {line(7, 1, 2, 11, 2, LineStatus::GoodTrack),
+                                          line(9, 0, 0, 0, 4, LineStatus::BadTrack),
                                           line(8, 5, 5, 6, 6, LineStatus::GoodTrack)};
   const std::string segments = image_annotations_json(1'500'000'000, lines, AnnotationStyle{}, 2);
   // Good tracks together (green), then bad (red); no detected ones: no empty list.
-  EXPECT_EQ(segments,
-            R"({"circles": [], "points": [{"timestamp": {"sec": 1, "nsec": 500000000}, "type": 4, "points": [{"x": 2.00, "y": 4.00}, {"x": 22.00, "y": 4.00}, )"
-            R"({"x": 10.00, "y": 10.00}, {"x": 12.00, "y": 12.00}], "outline_color": {"r": 0.240, "g": 0.860, "b": 0.310, "a": 1.000}, "outline_colors": [], )"
-            R"("fill_color": {"r": 0.000, "g": 0.000, "b": 0.000, "a": 0.000}, "thickness": 2}, {"timestamp": {"sec": 1, "nsec": 500000000}, "type": 4, )"
-            R"("points": [{"x": 0.00, "y": 0.00}, {"x": 0.00, "y": 8.00}], "outline_color": {"r": 0.900, "g": 0.160, "b": 0.160, "a": 1.000}, "outline_colors": [], )"
-            R"("fill_color": {"r": 0.000, "g": 0.000, "b": 0.000, "a": 0.000}, "thickness": 2}], "texts": []})");
+  EXPECT_EQ(
+      segments,
+      R"({"circles": [], "points": [{"timestamp": {"sec": 1, "nsec": 500000000}, "type": 4, "points": [{"x": 2.00, "y": 4.00}, {"x": 22.00, "y": 4.00}, )"
+      R"({"x": 10.00, "y": 10.00}, {"x": 12.00, "y": 12.00}], "outline_color": {"r": 0.240, "g": 0.860, "b": 0.310, "a": 1.000}, "outline_colors": [], )"
+      R"("fill_color": {"r": 0.000, "g": 0.000, "b": 0.000, "a": 0.000}, "thickness": 2}, {"timestamp": {"sec": 1, "nsec": 500000000}, "type": 4, )"
+      R"("points": [{"x": 0.00, "y": 0.00}, {"x": 0.00, "y": 8.00}], "outline_color": {"r": 0.900, "g": 0.160, "b": 0.160, "a": 1.000}, "outline_colors": [], )"
+      R"("fill_color": {"r": 0.000, "g": 0.000, "b": 0.000, "a": 0.000}, "thickness": 2}], "texts": []})");
   AnnotationStyle whole{.thickness = 2, .by_status = false, .ids = true};
   const std::string whole_lines = image_annotations_json(0, std::span(lines).first(1), whole, 1);
-  EXPECT_NE(whole_lines.find(R"("texts": [{"timestamp": {"sec": 0, "nsec": 0}, "position": {"x": 9.00, "y": 2.00}, "text": "7", )"), std::string::npos)
+  EXPECT_NE(whole_lines.find(
+                R"("texts": [{"timestamp": {"sec": 0, "nsec": 0}, "position": {"x": 9.00, "y": 2.00}, "text": "7", )"),
+            std::string::npos)
       << whole_lines;
-  EXPECT_NE(whole_lines.find(R"("outline_color": {"r": 0.160, "g": 0.820, "b": 0.900, "a": 1.000})"), std::string::npos) << whole_lines;
+  EXPECT_NE(whole_lines.find(R"("outline_color": {"r": 0.160, "g": 0.820, "b": 0.900, "a": 1.000})"), std::string::npos)
+      << whole_lines;
   EXPECT_EQ(image_annotations_json(0, {}, AnnotationStyle{}, 1), R"({"circles": [], "points": [], "texts": []})");
 }
 
@@ -55,8 +60,10 @@ TEST(ImageAnnotations, WithMotionEachLineGetsAnArrowAndItsVelocityInItsText) {
   const AnnotationStyle whole{.thickness = 2, .by_status = false, .ids = true, .motion = true};
   const std::string json = image_annotations_json(0, std::span(&moving, 1), whole, 2);
   // The arrow from the middle (6, 2) to (6, -3), scaled by 2, in orange.
-  EXPECT_NE(json.find(R"("points": [{"x": 12.00, "y": 4.00}, {"x": 12.00, "y": -6.00}], "outline_color": {"r": 1.000, "g": 0.550, "b": 0.000, "a": 1.000})"),
-            std::string::npos)
+  EXPECT_NE(
+      json.find(
+          R"("points": [{"x": 12.00, "y": 4.00}, {"x": 12.00, "y": -6.00}], "outline_color": {"r": 1.000, "g": 0.550, "b": 0.000, "a": 1.000})"),
+      std::string::npos)
       << json;
   EXPECT_NE(json.find(R"("text": "7 -50 px/s")"), std::string::npos) << json;
 }

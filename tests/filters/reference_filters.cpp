@@ -7,7 +7,6 @@
 
 namespace evldt::reference {
 
-
 // Never within a window of any event time, without overflow when the window is subtracted.
 constexpr Timestamp kNever = std::numeric_limits<Timestamp>::min() / 2;
 
@@ -17,7 +16,8 @@ BackgroundActivityFilter::BackgroundActivityFilter(SensorSize sensor, Timestamp 
       stride_(sensor.width + 2),
       last_event_(static_cast<std::size_t>(sensor.width + 2) * static_cast<std::size_t>(sensor.height + 2), 0),
       min_uncorrelated_(min_noise_hz * static_cast<double>(kJudgeUs) * 1e-6 * static_cast<double>(pixels())) {
-  if (window_us <= 0 || window_us > 1'000'000'000) throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
+  if (window_us <= 0 || window_us > 1'000'000'000)
+    throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
   if (!(min_noise_hz >= 0)) throw std::invalid_argument("the background-activity noise level must not be negative");
 }
 
@@ -37,9 +37,9 @@ void BackgroundActivityFilter::filter(const EventBatch& in, EventBatch& out) {
     // The pixel itself counts as support: a real edge often crosses a pixel's threshold twice in a
     // row, an isolated noise event rarely does (measured: on boxes-6dof this keeps F@1% at or above
     // no filter where the 8 neighbours alone cost 0.04 at a 10 ms window).
-    const bool correlated = recent(centre[0]) || recent(centre[-s - 1]) || recent(centre[-s]) || recent(centre[-s + 1]) ||
-                            recent(centre[-1]) || recent(centre[1]) || recent(centre[s - 1]) || recent(centre[s]) ||
-                            recent(centre[s + 1]);
+    const bool correlated = recent(centre[0]) || recent(centre[-s - 1]) || recent(centre[-s]) ||
+                            recent(centre[-s + 1]) || recent(centre[-1]) || recent(centre[1]) ||
+                            recent(centre[s - 1]) || recent(centre[s]) || recent(centre[s + 1]);
     *centre = now;
     if (t >= judge_end_) {
       // The uncorrelated events of the last period, per pixel and second, say whether the sensor is noisy.
@@ -66,12 +66,11 @@ void RefractoryFilter::filter(const EventBatch& in, EventBatch& out) {
   });
 }
 
-
-
 HotPixelFilter::HotPixelFilter(SensorSize sensor, const HotPixelParams& params)
     : EventFilter(sensor),
       params_(params),
-      min_count_(static_cast<std::uint32_t>(std::max(2.0, std::ceil(params.min_rate_hz * static_cast<double>(params.window_us) * 1e-6)))),
+      min_count_(static_cast<std::uint32_t>(
+          std::max(2.0, std::ceil(params.min_rate_hz * static_cast<double>(params.window_us) * 1e-6)))),
       release_count_(std::max<std::uint32_t>(1, min_count_ / 2)),
       counts_(pixels(), 0) {
   check_params(params);
@@ -112,14 +111,16 @@ void HotPixelFilter::judge_window() {
   for (const std::uint32_t i : touched_) {
     const std::uint32_t count = counts_[i] & ~kMasked;
     if (count < min_count_ || (counts_[i] & kMasked) != 0) continue;
-    const int x = static_cast<int>(i % static_cast<std::uint32_t>(width)), y = static_cast<int>(i / static_cast<std::uint32_t>(width));
+    const int x = static_cast<int>(i % static_cast<std::uint32_t>(width)),
+              y = static_cast<int>(i / static_cast<std::uint32_t>(width));
     std::uint64_t sum = 0;
     int neighbours = 0;
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
         const int nx = x + dx, ny = y + dy;
         if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-        sum += counts_[static_cast<std::size_t>(ny) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nx)] & ~kMasked;
+        sum += counts_[static_cast<std::size_t>(ny) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nx)] &
+               ~kMasked;
         ++neighbours;
       }
     }
@@ -130,7 +131,6 @@ void HotPixelFilter::judge_window() {
   for (const std::uint32_t i : masked_list_) counts_[i] = kMasked;
   touched_.clear();
 }
-
 
 namespace {
 constexpr std::uint8_t kSeen = 1, kFlickerBurst = 2;
@@ -170,7 +170,8 @@ bool AntiFlickerFilter::pass(Timestamp t, std::size_t pixel, bool on) {
     const std::uint32_t period = burst.period;
     const std::uint32_t n = (since + period / 2) / period;
     if (n >= 1 && n <= 3 && near(since, n * period)) {
-      if (n == 1 && since <= max_period_) burst.period = static_cast<std::uint16_t>(since);  // follows a drifting frequency
+      if (n == 1 && since <= max_period_)
+        burst.period = static_cast<std::uint16_t>(since);  // follows a drifting frequency
       burst.start = now;
       burst.flags |= kFlickerBurst;
       return false;
@@ -183,7 +184,8 @@ bool AntiFlickerFilter::pass(Timestamp t, std::size_t pixel, bool on) {
   }
   // Acquiring: consecutive bursts at a steady period inside the band.
   if (since >= min_period_ && since <= max_period_) {
-    burst.streak = burst.streak > 0 && near(since, burst.period) ? static_cast<std::uint8_t>(burst.streak + 1) : std::uint8_t{1};
+    burst.streak =
+        burst.streak > 0 && near(since, burst.period) ? static_cast<std::uint8_t>(burst.streak + 1) : std::uint8_t{1};
     burst.period = static_cast<std::uint16_t>(since);
   } else {
     burst.streak = 0;
@@ -195,7 +197,8 @@ bool AntiFlickerFilter::pass(Timestamp t, std::size_t pixel, bool on) {
 }
 
 void AntiFlickerFilter::filter(const EventBatch& in, EventBatch& out) {
-  keep_if(in, out, [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t p) { return pass(t, pixel(x, y), p > 0); });
+  keep_if(in, out,
+          [&](Timestamp t, std::uint16_t x, std::uint16_t y, std::int8_t p) { return pass(t, pixel(x, y), p > 0); });
 }
 
 FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) {
@@ -206,7 +209,8 @@ FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) {
       hot_pixel_ = filter.get();
       filters_.push_back(std::move(filter));
     } else if (name == "background-activity") {
-      filters_.push_back(std::make_unique<BackgroundActivityFilter>(sensor, config.background_window_us, config.background_min_noise_hz));
+      filters_.push_back(std::make_unique<BackgroundActivityFilter>(sensor, config.background_window_us,
+                                                                    config.background_min_noise_hz));
     } else if (name == "refractory") {
       filters_.push_back(std::make_unique<RefractoryFilter>(sensor, config.refractory_us));
     } else {

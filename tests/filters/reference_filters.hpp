@@ -73,13 +73,13 @@ class BackgroundActivityFilter final : public EventFilter {
 
  private:
   std::uint32_t window_us_;
-  int stride_;                             // the surface has a one-pixel border, so neighbours need no bounds checks
+  int stride_;  // the surface has a one-pixel border, so neighbours need no bounds checks
   // Per pixel, the low 32 bits of its last event's time (passed or not): half the memory traffic of
   // full times, and differences are exact for gaps under 71 minutes.
   std::vector<std::uint32_t> last_event_;
   bool started_ = false;
   static constexpr Timestamp kJudgeUs = 200'000;
-  double min_uncorrelated_;      // per judging period
+  double min_uncorrelated_;  // per judging period
   Timestamp judge_end_ = 0;
   std::uint64_t uncorrelated_ = 0;
   bool active_ = true;
@@ -115,7 +115,7 @@ class HotPixelFilter final : public EventFilter {
   // Per pixel, its events in the current window, with kMasked set while it is masked: one load per event.
   static constexpr std::uint32_t kMasked = 0x80000000u;
   std::vector<std::uint32_t> counts_;
-  std::vector<std::uint32_t> touched_;       // pixels with a count, to judge and reset
+  std::vector<std::uint32_t> touched_;  // pixels with a count, to judge and reset
   std::vector<std::uint32_t> masked_list_;
   std::vector<std::uint32_t> still_masked_;  // scratch of judge_window
 };
@@ -130,11 +130,11 @@ class AntiFlickerFilter final : public EventFilter {
   // Per pixel and polarity, 12 bytes. Times are the low 32 bits of us: differences are exact for
   // gaps under 71 minutes.
   struct Burst {
-    std::uint32_t start = 0;       // time of the current burst's first event
+    std::uint32_t start = 0;  // time of the current burst's first event
     std::uint32_t last_event = 0;
-    std::uint16_t period = 0;      // us, the locked or candidate period
-    std::uint8_t streak = 0;       // consistent periods in a row
-    std::uint8_t flags = 0;        // kSeen, kFlickerBurst
+    std::uint16_t period = 0;  // us, the locked or candidate period
+    std::uint8_t streak = 0;   // consistent periods in a row
+    std::uint8_t flags = 0;    // kSeen, kFlickerBurst
   };
   bool pass(Timestamp t, std::size_t pixel, bool on);
   [[nodiscard]] bool near(std::uint32_t a, std::uint32_t b) const;

@@ -19,7 +19,8 @@ struct Tagged {
 };
 
 EventBatch batch_of(std::vector<Tagged>& events) {
-  std::stable_sort(events.begin(), events.end(), [](const Tagged& a, const Tagged& b) { return a.event.t < b.event.t; });
+  std::stable_sort(events.begin(), events.end(),
+                   [](const Tagged& a, const Tagged& b) { return a.event.t < b.event.t; });
   EventBatch batch;
   for (const Tagged& e : events) batch.push_back(e.event);
   return batch;
@@ -32,7 +33,8 @@ FilterChain only(const std::string& name, FilterConfig config = {}) {
 }
 
 /// Runs `filter` over the stream in batches of `batch_size` and counts what passed of each tag.
-std::map<int, std::pair<int, int>> passed_by_tag(FilterChain& filter, std::vector<Tagged> events, std::size_t batch_size = 97) {
+std::map<int, std::pair<int, int>> passed_by_tag(FilterChain& filter, std::vector<Tagged> events,
+                                                 std::size_t batch_size = 97) {
   const EventBatch all = batch_of(events);
   std::map<std::tuple<Timestamp, int, int, int>, int> tag_of;
   std::map<int, std::pair<int, int>> counts;  // tag -> (passed, total)
@@ -44,16 +46,19 @@ std::map<int, std::pair<int, int>> passed_by_tag(FilterChain& filter, std::vecto
     EventBatch batch;
     for (std::size_t i = at; i < std::min(all.size(), at + batch_size); ++i) batch.push_back(all[i]);
     filter.filter(batch, batch);
-    for (std::size_t i = 0; i < batch.size(); ++i) ++counts[tag_of.at({batch.t[i], batch.x[i], batch.y[i], batch.p[i]})].first;
+    for (std::size_t i = 0; i < batch.size(); ++i)
+      ++counts[tag_of.at({batch.t[i], batch.x[i], batch.y[i], batch.p[i]})].first;
   }
   return counts;
 }
 
 /// A vertical edge sweeping right: column c fires (every row, ON) at t0 + c * column_us.
-void add_sweeping_edge(std::vector<Tagged>& events, Timestamp t0, Timestamp column_us, int tag, int x_first = 0, int x_last = kSensor.width - 1) {
+void add_sweeping_edge(std::vector<Tagged>& events, Timestamp t0, Timestamp column_us, int tag, int x_first = 0,
+                       int x_last = kSensor.width - 1) {
   for (int x = x_first; x <= x_last; ++x) {
     for (int y = 0; y < kSensor.height; ++y) {
-      events.push_back({{t0 + (x - x_first) * column_us + y, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), 1}, tag});
+      events.push_back(
+          {{t0 + (x - x_first) * column_us + y, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), 1}, tag});
     }
   }
 }
@@ -67,12 +72,15 @@ TEST(BackgroundActivity, CorrelatedEdgeEventsPassIsolatedEventsDrop) {
   add_sweeping_edge(events, 10'000, 500, /*tag=*/0);
   // Isolated events: pixels far apart, each alone in its neighbourhood for far longer than the window.
   for (int i = 0; i < 200; ++i) {
-    events.push_back({{200'000 + 10'000 * i, static_cast<std::uint16_t>((i * 7) % 64), static_cast<std::uint16_t>((i * 5) % 48), -1}, 1});
+    events.push_back(
+        {{200'000 + 10'000 * i, static_cast<std::uint16_t>((i * 7) % 64), static_cast<std::uint16_t>((i * 5) % 48), -1},
+         1});
   }
   const auto counts = passed_by_tag(filter, events);
   EXPECT_GE(counts.at(0).first, counts.at(0).second - 1);  // all but the very first event of the edge
   EXPECT_EQ(counts.at(1).first, 0);
-  EXPECT_EQ(filter.counts().background_activity, static_cast<std::uint64_t>(counts.at(0).second - counts.at(0).first + 200));
+  EXPECT_EQ(filter.counts().background_activity,
+            static_cast<std::uint64_t>(counts.at(0).second - counts.at(0).first + 200));
 }
 
 /// Isolated events at `hz` per pixel over the whole sensor, each alone in its neighbourhood.
@@ -80,7 +88,8 @@ void add_uncorrelated(std::vector<Tagged>& events, double hz, Timestamp from, Ti
   const auto spacing = static_cast<Timestamp>(1e6 / (hz * kSensor.width * kSensor.height));
   int i = 0;
   for (Timestamp t = from; t < to; t += spacing, ++i) {
-    events.push_back({{t, static_cast<std::uint16_t>((i * 37) % 64), static_cast<std::uint16_t>((i * 23) % 48), 1}, tag});
+    events.push_back(
+        {{t, static_cast<std::uint16_t>((i * 37) % 64), static_cast<std::uint16_t>((i * 23) % 48), 1}, tag});
   }
 }
 
@@ -104,7 +113,7 @@ TEST(Refractory, APixelFiresAtMostOncePerPeriod) {
   FilterChain filter = only("refractory", config);
   std::vector<Tagged> events;
   for (int i = 0; i < 10; ++i) events.push_back({{1000 + 50 * i, 3, 4, 1}, i % 2});  // even ones are 100 us apart
-  events.push_back({{1010, 5, 4, 1}, 0});  // another pixel, unaffected
+  events.push_back({{1010, 5, 4, 1}, 0});                                            // another pixel, unaffected
   const auto counts = passed_by_tag(filter, events, 3);
   EXPECT_EQ(counts.at(0), std::make_pair(6, 6));
   EXPECT_EQ(counts.at(1), std::make_pair(0, 5));
@@ -150,7 +159,8 @@ void add_flicker(std::vector<Tagged>& events, Timestamp from, Timestamp to, doub
       for (int y = 10; y < 20; ++y) {
         for (int k = 0; k < 3; ++k) {
           events.push_back({{t + 20 * k + y, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), 1}, tag});
-          events.push_back({{t + period / 2 + 20 * k + y, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), -1}, tag});
+          events.push_back(
+              {{t + period / 2 + 20 * k + y, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), -1}, tag});
         }
       }
     }
@@ -160,12 +170,13 @@ void add_flicker(std::vector<Tagged>& events, Timestamp from, Timestamp to, doub
 TEST(AntiFlicker, A100HzBurstTrainIsRemovedWhileAnEdgeUnderItIsKept) {
   FilterChain filter = only("anti-flicker");
   std::vector<Tagged> events;
-  add_flicker(events, 0, 50'000, 100, /*tag=*/0);           // locking on: 3 periods
-  add_flicker(events, 50'000, 1'000'000, 100, /*tag=*/1);   // locked
+  add_flicker(events, 0, 50'000, 100, /*tag=*/0);          // locking on: 3 periods
+  add_flicker(events, 50'000, 1'000'000, 100, /*tag=*/1);  // locked
   // Edges cross the patch (and the rest of the sensor) between the bursts, four times a second.
   for (Timestamp t0 = 102'500; t0 < 1'000'000; t0 += 250'000) add_sweeping_edge(events, t0, 20, /*tag=*/2, 18, 32);
   const auto counts = passed_by_tag(filter, events);
-  EXPECT_LE(counts.at(1).first, counts.at(1).second / 100) << "flicker passed: " << counts.at(1).first << " of " << counts.at(1).second;
+  EXPECT_LE(counts.at(1).first, counts.at(1).second / 100)
+      << "flicker passed: " << counts.at(1).first << " of " << counts.at(1).second;
   EXPECT_EQ(counts.at(2).first, counts.at(2).second) << "edge events dropped";
 }
 
@@ -191,8 +202,8 @@ TEST(FilterChain, RunsInOrderAndCountsEachReason) {
   FilterChain chain(config, kSensor);
   EventBatch batch;
   batch.push_back(100, 5, 5, 1);
-  batch.push_back(120, 5, 5, 1);  // refractory: 20 us after the previous at this pixel
-  batch.push_back(150, 6, 5, 1);  // correlated with (5, 5)
+  batch.push_back(120, 5, 5, 1);    // refractory: 20 us after the previous at this pixel
+  batch.push_back(150, 6, 5, 1);    // correlated with (5, 5)
   batch.push_back(900, 40, 40, 1);  // isolated
   EventBatch passed;
   chain.filter(batch, passed);

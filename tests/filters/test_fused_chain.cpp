@@ -48,7 +48,8 @@ Stream read_recording(const std::filesystem::path& path) {
   if (const auto geometry = source->geometry()) {
     sensor = *geometry;
   } else {
-    for (std::size_t i = 0; i < raw.size(); ++i) sensor = {std::max<int>(sensor.width, raw.x[i] + 1), std::max<int>(sensor.height, raw.y[i] + 1)};
+    for (std::size_t i = 0; i < raw.size(); ++i)
+      sensor = {std::max<int>(sensor.width, raw.x[i] + 1), std::max<int>(sensor.height, raw.y[i] + 1)};
   }
   EventValidator validator(sensor, kSlackUs);
   validator.filter(raw);
@@ -58,7 +59,8 @@ Stream read_recording(const std::filesystem::path& path) {
 const std::vector<Stream>& scenes() {
   static const std::vector<Stream> streams = [] {
     std::vector<Stream> all;
-    for (const char* name : {"noisy-boxes", "flicker-lamps", "night-boxes", "boxes-6dof"}) all.push_back(simulate(name));
+    for (const char* name : {"noisy-boxes", "flicker-lamps", "night-boxes", "boxes-6dof"})
+      all.push_back(simulate(name));
     return all;
   }();
   return streams;
@@ -73,7 +75,10 @@ std::vector<std::size_t> uneven_sizes(std::size_t seed) {
   for (int i = 0; i < 64; ++i) {
     s = s * 6364136223846793005u + 1442695040888963407u;
     const std::size_t kind = (s >> 60) % 4;
-    sizes.push_back(kind == 0 ? 1 + (s >> 40) % 7 : kind == 1 ? 1 + (s >> 40) % 300 : kind == 2 ? 1 + (s >> 40) % 5000 : 1 + (s >> 40) % 70'000);
+    sizes.push_back(kind == 0   ? 1 + (s >> 40) % 7
+                    : kind == 1 ? 1 + (s >> 40) % 300
+                    : kind == 2 ? 1 + (s >> 40) % 5000
+                                : 1 + (s >> 40) % 70'000);
   }
   return sizes;
 }
@@ -125,10 +130,11 @@ void expect_same_as_reference(const Stream& stream) {
     const EventBatch kept = run(fused, stream.events, uneven_sizes(2), true);
 
     const FilterCounts want = reference.counts(), got = fused.counts();
-    std::printf("  %-32s %-58s %9zu in %9zu kept  hot-pixel %7llu  anti-flicker %7llu  background %7llu  refractory %7llu\n",
-                stream.name.c_str(), setting.chain, stream.events.size(), kept.size(), static_cast<unsigned long long>(got.hot_pixel),
-                static_cast<unsigned long long>(got.anti_flicker), static_cast<unsigned long long>(got.background_activity),
-                static_cast<unsigned long long>(got.refractory));
+    std::printf(
+        "  %-32s %-58s %9zu in %9zu kept  hot-pixel %7llu  anti-flicker %7llu  background %7llu  refractory %7llu\n",
+        stream.name.c_str(), setting.chain, stream.events.size(), kept.size(),
+        static_cast<unsigned long long>(got.hot_pixel), static_cast<unsigned long long>(got.anti_flicker),
+        static_cast<unsigned long long>(got.background_activity), static_cast<unsigned long long>(got.refractory));
     EXPECT_EQ(got.events_in, want.events_in);
     EXPECT_EQ(got.passed, want.passed);
     EXPECT_EQ(got.hot_pixel, want.hot_pixel);
@@ -145,9 +151,9 @@ void expect_same_as_reference(const Stream& stream) {
     ASSERT_EQ(kept.size(), expected.size());
     for (std::size_t i = 0; i < kept.size(); ++i) {
       if (kept[i] != expected[i]) {
-        ADD_FAILURE() << "kept event " << i << " differs: t " << kept.t[i] << " (" << kept.x[i] << ", " << kept.y[i] << ") "
-                      << int{kept.p[i]} << ", the reference t " << expected.t[i] << " (" << expected.x[i] << ", " << expected.y[i]
-                      << ") " << int{expected.p[i]};
+        ADD_FAILURE() << "kept event " << i << " differs: t " << kept.t[i] << " (" << kept.x[i] << ", " << kept.y[i]
+                      << ") " << int{kept.p[i]} << ", the reference t " << expected.t[i] << " (" << expected.x[i]
+                      << ", " << expected.y[i] << ") " << int{expected.p[i]};
         break;
       }
     }
@@ -160,7 +166,8 @@ TEST(FusedChain, KeepsWhatTheFiltersOneByOneKeptOnTheNoisyScenes) {
 
 TEST(FusedChain, KeepsWhatTheFiltersOneByOneKeptOnRealRecordings) {
   const std::filesystem::path real = real_recordings();
-  if (!std::filesystem::is_directory(real)) GTEST_SKIP() << "no real recordings at " << real << " (../shared is absent)";
+  if (!std::filesystem::is_directory(real))
+    GTEST_SKIP() << "no real recordings at " << real << " (../shared is absent)";
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(real)) {
     if (entry.is_regular_file() && entry.path().extension() != ".md") files.push_back(entry.path());

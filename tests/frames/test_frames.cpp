@@ -37,8 +37,9 @@ constexpr SensorSize kSensor{64, 48};
 class FramesTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    folder_ = std::filesystem::temp_directory_path() /
-              ("evldt_frames_" + std::to_string(getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    folder_ =
+        std::filesystem::temp_directory_path() / ("evldt_frames_" + std::to_string(getpid()) + "_" +
+                                                  ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::remove_all(folder_);
   }
   void TearDown() override { std::filesystem::remove_all(folder_); }
@@ -148,8 +149,8 @@ void put_string(std::vector<std::uint8_t>& out, const std::string& text) {
 /// A sensor_msgs/Image as ROS 1 serializes it: header (seq, stamp, frame_id), height, width,
 /// encoding, is_bigendian, step, data; `image` (grey, or BGR for bgr8 and rgb8) in the given pixel
 /// encoding, rows padded by `row_padding` bytes, the data `cut` bytes short.
-RawRosMessage ros_image(Timestamp t_us, const cv::Mat& image, const std::string& encoding, bool big_endian = false, int row_padding = 0,
-                        std::size_t cut = 0) {
+RawRosMessage ros_image(Timestamp t_us, const cv::Mat& image, const std::string& encoding, bool big_endian = false,
+                        int row_padding = 0, std::size_t cut = 0) {
   RawRosMessage message{"sensor_msgs/Image", {}, {}};
   std::vector<std::uint8_t>& out = message.bytes;
   put32(out, 1);  // seq
@@ -173,7 +174,8 @@ RawRosMessage ros_image(Timestamp t_us, const cv::Mat& image, const std::string&
       }
       const std::uint8_t grey = image.at<std::uint8_t>(y, x);
       if (pixel_bytes == 2) {
-        const auto wide = static_cast<std::uint16_t>(grey << 8 | 0xff);  // the low byte is dropped, not rounded into the high one
+        const auto wide =
+            static_cast<std::uint16_t>(grey << 8 | 0xff);  // the low byte is dropped, not rounded into the high one
         data.push_back(static_cast<std::uint8_t>(big_endian ? wide >> 8 : wide & 0xff));
         data.push_back(static_cast<std::uint8_t>(big_endian ? wide & 0xff : wide >> 8));
       } else {
@@ -219,8 +221,8 @@ TEST_F(BagFramesTest, EveryPixelEncodingReadsAsTheGreyItHolds) {
   for (std::size_t k = 0; k < encodings.size(); ++k) {
     const int left = 4 + 6 * static_cast<int>(k);
     const bool colour = encodings[k] != "mono8" && encodings[k] != "mono16";
-    images.push_back(ros_image(1'700'000'000'000'000 + 10'000 * static_cast<Timestamp>(k), colour ? coloured_square(left) : square(left),
-                               encodings[k], k == 2, k == 3 ? 5 : 0));
+    images.push_back(ros_image(1'700'000'000'000'000 + 10'000 * static_cast<Timestamp>(k),
+                               colour ? coloured_square(left) : square(left), encodings[k], k == 2, k == 3 ? 5 : 0));
     expected.push_back(square(left));
     if (colour) cv::cvtColor(coloured_square(left), expected.back(), cv::COLOR_BGR2GRAY);
   }
@@ -240,14 +242,19 @@ TEST_F(BagFramesTest, EveryPixelEncodingReadsAsTheGreyItHolds) {
 
 TEST_F(BagFramesTest, BadInputsNameTheFrame) {
   const Timestamp t0 = 1'700'000'000'000'000;
-  const auto nth = [](const std::string& error) { return error.find("message 1 of /dvs/image_raw") != std::string::npos; };
-  std::string error = read_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "bayer_rggb8")}));
+  const auto nth = [](const std::string& error) {
+    return error.find("message 1 of /dvs/image_raw") != std::string::npos;
+  };
+  std::string error =
+      read_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "bayer_rggb8")}));
   EXPECT_TRUE(nth(error) && error.find("pixel encoding 'bayer_rggb8'") != std::string::npos) << error;
-  error = read_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)), "mono8")}));
+  error = read_error(write_bag(
+      {ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)), "mono8")}));
   EXPECT_TRUE(nth(error) && error.find("frame is 10x10, the sensor 64x48") != std::string::npos) << error;
   error = read_error(write_bag({ros_image(t0 + 10, square(8), "mono8"), ros_image(t0, square(8), "mono8")}));
   EXPECT_TRUE(nth(error) && error.find("earlier than the one before") != std::string::npos) << error;
-  error = read_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "mono16", false, 0, 7)}));
+  error =
+      read_error(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "mono16", false, 0, 7)}));
   EXPECT_TRUE(nth(error) && error.find("holds only") != std::string::npos) << error;
   const std::filesystem::path good = write_bag({ros_image(t0, square(8), "mono8")});
   error = read_error(good, "/imu");
@@ -258,7 +265,8 @@ TEST_F(BagFramesTest, BadInputsNameTheFrame) {
   error = read_error(folder_ / "junk.bin");
   EXPECT_NE(error.find("not a source of frames"), std::string::npos) << error;
   // Nothing is scored from a bag whose frames throw.
-  const auto reader = open_frames(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "yuv422")}), "", kSensor);
+  const auto reader =
+      open_frames(write_bag({ros_image(t0, square(8), "mono8"), ros_image(t0 + 1, square(8), "yuv422")}), "", kSensor);
   EXPECT_THROW(frame_ground_truth_steps(*reader, LsdParams{}), FrameError);
 }
 
@@ -284,7 +292,8 @@ TEST_F(FramesTest, Ros2BagFramesInCdrOfEitherByteOrder) {
     test_support::BagWriter bag(path);
     bag.topic(1, "/events", "event_camera_msgs/msg/EventPacket");
     bag.topic(2, "/dvs/image_raw", "sensor_msgs/msg/Image");
-    for (int k = 0; k < 4; ++k) bag.message(2, 1'000'000'000 + k, ros2_image(1'700'000'000'000'000 + 10'000 * k, square(4 + 6 * k), k % 2 == 0));
+    for (int k = 0; k < 4; ++k)
+      bag.message(2, 1'000'000'000 + k, ros2_image(1'700'000'000'000'000 + 10'000 * k, square(4 + 6 * k), k % 2 == 0));
     bag.message(2, 1'000'000'100, {0, 1, 0, 0, 1});  // a message cut short
   }
   const auto reader = open_frames(path, "", kSensor);
@@ -298,13 +307,16 @@ TEST_F(FramesTest, Ros2BagFramesInCdrOfEitherByteOrder) {
     reader->next();
     ADD_FAILURE() << "a cut message must be an error";
   } catch (const FrameError& e) {
-    EXPECT_NE(std::string(e.what()).find("message id 5 of /dvs/image_raw: CDR byte 4: message ends early"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("message id 5 of /dvs/image_raw: CDR byte 4: message ends early"),
+              std::string::npos)
+        << e.what();
   }
   try {
     open_frames(path, "/events", kSensor);
     ADD_FAILURE() << "an event topic holds no frames";
   } catch (const FrameError& e) {
-    EXPECT_NE(std::string(e.what()).find("topic /events is of type event_camera_msgs/msg/EventPacket, not sensor_msgs/msg/Image"),
+    EXPECT_NE(std::string(e.what()).find(
+                  "topic /events is of type event_camera_msgs/msg/EventPacket, not sensor_msgs/msg/Image"),
               std::string::npos)
         << e.what();
   }
@@ -312,12 +324,14 @@ TEST_F(FramesTest, Ros2BagFramesInCdrOfEitherByteOrder) {
 
 /// An HDF5 file in MVSEC's layout: `frames` (8-bit grey, all one size) as N x H x W at `dataset`,
 /// their times in seconds at dataset + "_ts" (`times` may differ in count, to make a bad file).
-void write_mvsec_frames(const std::filesystem::path& path, const std::vector<cv::Mat>& frames, const std::vector<double>& times,
-                        const std::string& dataset = "/davis/left/image_raw", hid_t pixel_type = H5T_NATIVE_UINT8) {
+void write_mvsec_frames(const std::filesystem::path& path, const std::vector<cv::Mat>& frames,
+                        const std::vector<double>& times, const std::string& dataset = "/davis/left/image_raw",
+                        hid_t pixel_type = H5T_NATIVE_UINT8) {
   const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   const hid_t links = H5Pcreate(H5P_LINK_CREATE);
   H5Pset_create_intermediate_group(links, 1);
-  const hsize_t dims[3] = {frames.size(), static_cast<hsize_t>(frames.front().rows), static_cast<hsize_t>(frames.front().cols)};
+  const hsize_t dims[3] = {frames.size(), static_cast<hsize_t>(frames.front().rows),
+                           static_cast<hsize_t>(frames.front().cols)};
   const hid_t space = H5Screate_simple(3, dims, nullptr);
   const hid_t images = H5Dcreate2(file, dataset.c_str(), pixel_type, space, links, H5P_DEFAULT, H5P_DEFAULT);
   std::vector<std::uint8_t> pixels;
@@ -325,7 +339,8 @@ void write_mvsec_frames(const std::filesystem::path& path, const std::vector<cv:
   if (pixel_type == H5T_NATIVE_UINT8) H5Dwrite(images, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, pixels.data());
   const hsize_t count = times.size();
   const hid_t time_space = H5Screate_simple(1, &count, nullptr);
-  const hid_t stamps = H5Dcreate2(file, (dataset + "_ts").c_str(), H5T_NATIVE_DOUBLE, time_space, links, H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t stamps =
+      H5Dcreate2(file, (dataset + "_ts").c_str(), H5T_NATIVE_DOUBLE, time_space, links, H5P_DEFAULT, H5P_DEFAULT);
   H5Dwrite(stamps, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, times.data());
   for (const hid_t id : {stamps, time_space, images, space, links}) H5Idec_ref(id);
   H5Fclose(file);
@@ -359,9 +374,11 @@ TEST_F(FramesTest, MvsecHdf5BadInputsAreClearErrors) {
   write_mvsec_frames(path, {square(4), square(8)}, {1.0});
   EXPECT_NE(error().find("/davis/left/image_raw_ts holds 1 times for 2 frames"), std::string::npos) << error();
   write_mvsec_frames(path, {square(4)}, {1.0});
-  EXPECT_NE(error("/davis/right/image_raw").find("no frames /davis/right/image_raw"), std::string::npos) << error("/davis/right/image_raw");
+  EXPECT_NE(error("/davis/right/image_raw").find("no frames /davis/right/image_raw"), std::string::npos)
+      << error("/davis/right/image_raw");
   write_mvsec_frames(path, {square(4), square(8)}, {1.0, 0.5});
-  EXPECT_NE(error().find("image_raw[1]: frame at 500000 us is earlier than the one before"), std::string::npos) << error();
+  EXPECT_NE(error().find("image_raw[1]: frame at 500000 us is earlier than the one before"), std::string::npos)
+      << error();
   write_mvsec_frames(path, {cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))}, {1.0});
   EXPECT_NE(error().find("frame is 10x10, the sensor 64x48"), std::string::npos) << error();
   write_mvsec_frames(path, {square(4)}, {1.0}, "/davis/left/image_raw", H5T_NATIVE_UINT16);
@@ -388,25 +405,30 @@ void write_bytes(const std::filesystem::path& path, const std::string& header, c
 }
 
 /// An AEDAT 3.1 packet: the 28-byte header, then `capacity` events of `event_size` bytes.
-void put_aedat31_packet(std::vector<std::uint8_t>& out, std::int16_t type, std::int32_t event_size, std::int32_t overflow,
-                        std::int32_t capacity, const std::vector<std::uint8_t>& events) {
+void put_aedat31_packet(std::vector<std::uint8_t>& out, std::int16_t type, std::int32_t event_size,
+                        std::int32_t overflow, std::int32_t capacity, const std::vector<std::uint8_t>& events) {
   put16(out, static_cast<std::uint16_t>(type));
   put16(out, 1);  // source
-  for (const std::int32_t field : {event_size, 4, overflow, capacity, capacity, capacity}) put32(out, static_cast<std::uint32_t>(field));
+  for (const std::int32_t field : {event_size, 4, overflow, capacity, capacity, capacity})
+    put32(out, static_cast<std::uint32_t>(field));
   out.insert(out.end(), events.begin(), events.end());
   out.resize(out.size() + static_cast<std::size_t>(event_size) * static_cast<std::size_t>(capacity) - events.size(), 0);
 }
 
 /// A frame event: info (valid, channels), times, size, position, then the grey image's pixels as
 /// 16-bit values (the grey in the high byte, noise in the low one), padded to `event_size`.
-void put_aedat31_frame(std::vector<std::uint8_t>& out, std::size_t event_size, const cv::Mat& grey, bool valid, std::uint32_t channels,
-                       std::int32_t start_exposure, std::int32_t end_exposure, std::int32_t claimed_width = 0) {
+void put_aedat31_frame(std::vector<std::uint8_t>& out, std::size_t event_size, const cv::Mat& grey, bool valid,
+                       std::uint32_t channels, std::int32_t start_exposure, std::int32_t end_exposure,
+                       std::int32_t claimed_width = 0) {
   const std::size_t start = out.size();
   put32(out, (valid ? 1u : 0u) | channels << 1);
-  for (const std::int32_t t : {start_exposure - 100, end_exposure + 100, start_exposure, end_exposure}) put32(out, static_cast<std::uint32_t>(t));
-  for (const int field : {claimed_width > 0 ? claimed_width : grey.cols, grey.rows, 0, 0}) put32(out, static_cast<std::uint32_t>(field));
+  for (const std::int32_t t : {start_exposure - 100, end_exposure + 100, start_exposure, end_exposure})
+    put32(out, static_cast<std::uint32_t>(t));
+  for (const int field : {claimed_width > 0 ? claimed_width : grey.cols, grey.rows, 0, 0})
+    put32(out, static_cast<std::uint32_t>(field));
   for (int y = 0; y < grey.rows; ++y) {
-    for (int x = 0; x < grey.cols; ++x) put16(out, static_cast<std::uint16_t>(grey.at<std::uint8_t>(y, x) << 8 | ((x * 7 + y) & 0xFF)));
+    for (int x = 0; x < grey.cols; ++x)
+      put16(out, static_cast<std::uint16_t>(grey.at<std::uint8_t>(y, x) << 8 | ((x * 7 + y) & 0xFF)));
   }
   out.resize(start + event_size, 0);
 }
@@ -450,7 +472,8 @@ TEST_F(FramesTest, Aedat31BadFramesNameTheFrame) {
   std::vector<std::uint8_t> data, frame;
   put_aedat31_frame(frame, kFrameEventSize, square(4), true, 3, 1000, 2000);
   put_aedat31_packet(data, 2, static_cast<std::int32_t>(kFrameEventSize), 0, 1, frame);
-  EXPECT_NE(error(data).find("bad.aedat: frame 0 of the frame packet at byte 64: 3 colour channels"), std::string::npos) << error(data);
+  EXPECT_NE(error(data).find("bad.aedat: frame 0 of the frame packet at byte 64: 3 colour channels"), std::string::npos)
+      << error(data);
   data.clear();
   frame.clear();
   put_aedat31_frame(frame, kFrameEventSize, square(4), true, 1, 1000, 2000, 200);
@@ -472,8 +495,10 @@ TEST_F(FramesTest, Aedat31BadFramesNameTheFrame) {
 }
 
 /// jAER's DAVIS APS samples of one pixel (image coordinates: jAER mirrors both axes).
-void put_aps_sample(std::vector<std::uint8_t>& out, int x, int y, std::uint32_t read, std::uint32_t value, std::uint32_t t, int side) {
-  put_be32(out, 0x80000000u | static_cast<std::uint32_t>(side - 1 - y) << 22 | static_cast<std::uint32_t>(side - 1 - x) << 12 | read << 10 | value);
+void put_aps_sample(std::vector<std::uint8_t>& out, int x, int y, std::uint32_t read, std::uint32_t value,
+                    std::uint32_t t, int side) {
+  put_be32(out, 0x80000000u | static_cast<std::uint32_t>(side - 1 - y) << 22 |
+                    static_cast<std::uint32_t>(side - 1 - x) << 12 | read << 10 | value);
   put_be32(out, t);
 }
 
@@ -493,12 +518,14 @@ TEST_F(FramesTest, Aedat2DavisApsFramesAreResetMinusSignal) {
   std::vector<Timestamp> expected_times;
   for (int frame = 0; frame < 2; ++frame) {
     const std::uint32_t last_reset = t + kSide * kSide / 1000, first_signal = t + 5000;
-    for (int p = 0; p < kSide * kSide; ++p) put_aps_sample(data, p % kSide, p / kSide, 0, 1023, t + static_cast<std::uint32_t>(p / 1000), kSide);
+    for (int p = 0; p < kSide * kSide; ++p)
+      put_aps_sample(data, p % kSide, p / kSide, 0, 1023, t + static_cast<std::uint32_t>(p / 1000), kSide);
     put_be32(data, 0x80000C00u);  // an IMU sample
     put_be32(data, t + 20);
     for (int p = 0; p < kSide * kSide; ++p) {
       const std::uint32_t light = 4u * scene.at<std::uint8_t>(p / kSide, (p % kSide + 3 * frame) % kSide);
-      put_aps_sample(data, p % kSide, p / kSide, 1, 1023 - light, first_signal + static_cast<std::uint32_t>(p / 1000), kSide);
+      put_aps_sample(data, p % kSide, p / kSide, 1, 1023 - light, first_signal + static_cast<std::uint32_t>(p / 1000),
+                     kSide);
     }
     expected_times.push_back(last_reset + (first_signal - last_reset) / 2);
     t += 40000;
@@ -513,7 +540,8 @@ TEST_F(FramesTest, Aedat2DavisApsFramesAreResetMinusSignal) {
     EXPECT_EQ(read->t_us, expected_times[static_cast<std::size_t>(frame)]);
     cv::Mat shifted(kSide, kSide, CV_8UC1);
     for (int y = 0; y < kSide; ++y) {
-      for (int x = 0; x < kSide; ++x) shifted.at<std::uint8_t>(y, x) = scene.at<std::uint8_t>(y, (x + 3 * frame) % kSide);
+      for (int x = 0; x < kSide; ++x)
+        shifted.at<std::uint8_t>(y, x) = scene.at<std::uint8_t>(y, (x + 3 * frame) % kSide);
     }
     EXPECT_EQ(cv::norm(read->image, shifted, cv::NORM_INF), 0.0) << read->name;
     EXPECT_NE(read->name.find("davis128.aedat: APS frame " + std::to_string(frame)), std::string::npos) << read->name;
@@ -525,7 +553,8 @@ TEST_F(FramesTest, Aedat2DavisApsFramesAreResetMinusSignal) {
     open_frames(path, "", sensor);
     ADD_FAILURE() << "a DVS128 recording gave frames";
   } catch (const FrameError& e) {
-    EXPECT_NE(std::string(e.what()).find("DVS128 recording (its chip has no APS frames)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("DVS128 recording (its chip has no APS frames)"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -546,8 +575,8 @@ std::vector<std::uint8_t> stored(const flatbuffers::FlatBufferBuilder& builder, 
 /// A frame as DV writes one per FRME packet: built by slot number (as DV's own accessors read them:
 /// timestamp 4, start / end of exposure 10 / 12, format 14, sizeX 16, sizeY 18, pixels 24), not
 /// through evldt's schema, so a slot evldt's schema put elsewhere would fail here.
-std::vector<std::uint8_t> dv_frame(Timestamp t, Timestamp start_exposure, Timestamp end_exposure, std::int8_t format, const cv::Mat& image,
-                                   std::size_t pixels_cut = 0, Writer writer = Writer::Dv) {
+std::vector<std::uint8_t> dv_frame(Timestamp t, Timestamp start_exposure, Timestamp end_exposure, std::int8_t format,
+                                   const cv::Mat& image, std::size_t pixels_cut = 0, Writer writer = Writer::Dv) {
   flatbuffers::FlatBufferBuilder builder;
   const cv::Mat continuous = image.clone();
   const auto pixels = builder.CreateVector(continuous.data, continuous.total() * continuous.elemSize() - pixels_cut);
@@ -570,12 +599,16 @@ std::vector<std::uint8_t> dv_frame(Timestamp t, Timestamp start_exposure, Timest
 
 /// An AEDAT 4.0 file (uncompressed) of an event stream (0) and, unless `frames_stream` is false, a
 /// frame stream (2), each payload a packet of the stream given.
-void write_aedat4(const std::filesystem::path& path, const std::vector<std::pair<int, std::vector<std::uint8_t>>>& packets,
-                  bool frames_stream = true, Writer writer = Writer::Dv) {
-  const std::string info = std::string(R"(<dv version="2.0"><node name="outInfo" path="/mainloop/Recorder/outInfo/">)") +
-                           R"(<node name="0" path="/mainloop/Recorder/outInfo/0/"><attr key="typeIdentifier" type="string">EVTS</attr></node>)" +
-                           (frames_stream ? R"(<node name="2" path="/mainloop/Recorder/outInfo/2/"><attr key="typeIdentifier" type="string">FRME</attr></node>)" : "") +
-                           "</node></dv>";
+void write_aedat4(const std::filesystem::path& path,
+                  const std::vector<std::pair<int, std::vector<std::uint8_t>>>& packets, bool frames_stream = true,
+                  Writer writer = Writer::Dv) {
+  const std::string info =
+      std::string(R"(<dv version="2.0"><node name="outInfo" path="/mainloop/Recorder/outInfo/">)") +
+      R"(<node name="0" path="/mainloop/Recorder/outInfo/0/"><attr key="typeIdentifier" type="string">EVTS</attr></node>)" +
+      (frames_stream
+           ? R"(<node name="2" path="/mainloop/Recorder/outInfo/2/"><attr key="typeIdentifier" type="string">FRME</attr></node>)"
+           : "") +
+      "</node></dv>";
   flatbuffers::FlatBufferBuilder header;
   const auto table = aedat4::CreateIOHeaderDirect(header, aedat4::CompressionType::NONE, -1, info.c_str());
   if (writer == Writer::Dv) {
@@ -603,8 +636,9 @@ TEST_F(FramesTest, Aedat4FrameStreamsReadGreyAndColourAtTheMiddleOfTheirExposure
                       {2, dv_frame(1'040'000, 1'040'000, 1'041'000, 16, coloured_square(16))},
                       {2, dv_frame(1'080'000, 0, 0, 0, square(28))}});  // no exposure given: its time stamp
   const auto reader = open_frames(path, "", kSensor);
-  for (const auto& [t, expected] : {std::pair{Timestamp{1'002'000}, square(4)}, std::pair{Timestamp{1'040'500}, colour_grey},
-                                    std::pair{Timestamp{1'080'000}, square(28)}}) {
+  for (const auto& [t, expected] :
+       {std::pair{Timestamp{1'002'000}, square(4)}, std::pair{Timestamp{1'040'500}, colour_grey},
+        std::pair{Timestamp{1'080'000}, square(28)}}) {
     const auto frame = reader->next();
     ASSERT_TRUE(frame);
     EXPECT_EQ(frame->t_us, t);
@@ -656,12 +690,15 @@ TEST_F(FramesTest, Aedat4BadFramesNameTheFrame) {
 // A real DVXplorer recording has events only: asked for frames, it is refused by name.
 TEST_F(FramesTest, Aedat4RecordingWithoutFramesIsRefusedByName) {
   const std::filesystem::path recording = std::filesystem::path(EVLDT_SHARED_DIR) / "real" / "dvxplorer_person.aedat4";
-  if (!std::filesystem::exists(recording)) GTEST_SKIP() << "no real recordings at " << recording.parent_path() << " (../shared is absent)";
+  if (!std::filesystem::exists(recording))
+    GTEST_SKIP() << "no real recordings at " << recording.parent_path() << " (../shared is absent)";
   try {
     open_frames(recording, "", {320, 240});
     ADD_FAILURE() << "a recording without frames gave a frame reader";
   } catch (const FrameError& e) {
-    EXPECT_NE(std::string(e.what()).find("dvxplorer_person.aedat4: no frame stream (FRME) in the header"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("dvxplorer_person.aedat4: no frame stream (FRME) in the header"),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -670,7 +707,8 @@ TEST_F(FramesTest, VideoFramesOnTheClockOfTheEventsEmulatedFromThem) {
   std::filesystem::create_directories(folder_);
   const std::filesystem::path path = folder_ / "clip.avi";
   {
-    cv::VideoWriter writer(path.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25, cv::Size(kSensor.width, kSensor.height), false);
+    cv::VideoWriter writer(path.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25,
+                           cv::Size(kSensor.width, kSensor.height), false);
     ASSERT_TRUE(writer.isOpened());
     for (int k = 0; k < 4; ++k) writer.write(square(4 + 6 * k));
   }
@@ -681,7 +719,8 @@ TEST_F(FramesTest, VideoFramesOnTheClockOfTheEventsEmulatedFromThem) {
     EXPECT_EQ(frame->t_us, 40'000 * k);
     EXPECT_EQ(frame->t_us, video_frame_time_us(static_cast<std::uint64_t>(k), 25));
     ASSERT_EQ(frame->image.type(), CV_8UC1);
-    EXPECT_LT(cv::norm(frame->image, square(4 + 6 * k), cv::NORM_L1) / static_cast<double>(frame->image.total()), 3.0) << frame->name;  // JPEG
+    EXPECT_LT(cv::norm(frame->image, square(4 + 6 * k), cv::NORM_L1) / static_cast<double>(frame->image.total()), 3.0)
+        << frame->name;  // JPEG
   }
   EXPECT_FALSE(reader->next());
   const auto small = open_frames(path, "", SensorSize{32, 24});
@@ -700,13 +739,14 @@ TEST(EventSupport, ALineIsSeenWhereEventsFellAlongItAroundTheFrame) {
   };
   std::vector<EventBatch> batches(2);
   const auto along = [&](EventBatch& batch, Timestamp t, int y, int x_from, int x_to) {
-    for (int x = x_from; x <= x_to; ++x) batch.push_back(t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), 1);
+    for (int x = x_from; x <= x_to; ++x)
+      batch.push_back(t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), 1);
   };
-  along(batches[0], 95'000, 10, 10, 40);   // the upper line, 5 ms before the first frame
-  along(batches[0], 150'000, 30, 10, 40);  // the lower line, 50 ms from either frame: too far
+  along(batches[0], 95'000, 10, 10, 40);       // the upper line, 5 ms before the first frame
+  along(batches[0], 150'000, 30, 10, 40);      // the lower line, 50 ms from either frame: too far
   batches[0].push_back(160'000, 1000, 10, 1);  // off the sensor: passed over
-  along(batches[1], 198'000, 11, 10, 20);  // a third of the upper line, 1 px off it: not half
-  along(batches[1], 205'000, 29, 10, 40);  // the lower line, 1 px off it, 5 ms after the second frame
+  along(batches[1], 198'000, 11, 10, 20);      // a third of the upper line, 1 px off it: not half
+  along(batches[1], 205'000, 29, 10, 40);      // the lower line, 1 px off it, 5 ms after the second frame
   std::size_t next = 0;
   const auto supported = event_supported_pieces(truth, {64, 48}, EventSupportRule{}, [&](EventBatch& batch) {
     if (next == batches.size()) return false;
@@ -773,7 +813,8 @@ TEST_F(FramesTest, LsdOnSimulatedFramesMatchesTheExactLines) {
   const auto frames = open_ecd_frames(folder_, scene.sensor);
   const GroundTruthSteps lsd = frame_ground_truth_steps(*frames, LsdParams{});
   ASSERT_EQ(lsd.times.size(), 11u);
-  const StreamEvaluator evaluator = evaluate_steps_against(lsd, scene_ground_truth_steps(scene, 20'000), scene.sensor, {0.01});
+  const StreamEvaluator evaluator =
+      evaluate_steps_against(lsd, scene_ground_truth_steps(scene, 20'000), scene.sensor, {0.01});
   EXPECT_EQ(evaluator.hold_us(), 30'000);
   EXPECT_GT(evaluator.accuracy().summed_prf(0).f, 0.9);
 }

@@ -23,7 +23,8 @@ void fuzz_message(evldt::RosSerialization serialization, std::string_view type, 
   try {
     const auto layout = evldt::RosEventLayout::of(serialization, type, "");
     const auto events = layout->decode(bytes, scratch).events;
-    const bool in_message = events.empty() || (events.data() >= bytes.data() && events.data() + events.size() <= bytes.data() + bytes.size());
+    const bool in_message = events.empty() || (events.data() >= bytes.data() &&
+                                               events.data() + events.size() <= bytes.data() + bytes.size());
     const bool repacked = events.data() == scratch.data() && events.size() == scratch.size() && events.size() % 13 == 0;
     evldt::fuzz::require(in_message || repacked, "event bytes outside the message");
   } catch (const std::runtime_error&) {
@@ -35,7 +36,8 @@ void fuzz_file(std::string_view magic, std::span<const std::uint8_t> rest, const
   file.insert(file.end(), rest.begin(), rest.end());
   const evldt::fuzz::TempFile temp(file, suffix);
   try {
-    evldt::PacketEventReader reader(magic == evldt::kMcapMagic ? evldt::open_mcap(temp.path(), "") : evldt::open_aedat4(temp.path()), "fuzz");
+    evldt::PacketEventReader reader(
+        magic == evldt::kMcapMagic ? evldt::open_mcap(temp.path(), "") : evldt::open_aedat4(temp.path()), "fuzz");
     (void)reader.geometry();
     evldt::EventBatch batch;
     evldt::fuzz::read_to_the_end(reader, batch);
@@ -53,7 +55,8 @@ void fuzz_images(std::string_view magic, std::span<const std::uint8_t> rest, con
     evldt::RecordingImage image;
     std::string location;
     while (images->next(image, location)) {
-      evldt::fuzz::require(image.data.size() >= std::size_t{image.step} * image.height, "an image's rows lie outside its bytes");
+      evldt::fuzz::require(image.data.size() >= std::size_t{image.step} * image.height,
+                           "an image's rows lie outside its bytes");
     }
   } catch (const std::runtime_error&) {
   }
@@ -66,15 +69,33 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using evldt::RosSerialization;
   const std::span<const std::uint8_t> rest(data + 1, size - 1);
   switch (data[0] % 9) {
-    case 0: fuzz_message(RosSerialization::Cdr, evldt::kRos2EventPacketType, rest); break;
-    case 1: fuzz_message(RosSerialization::Cdr, evldt::kRos2EventArrayType, rest); break;
-    case 2: fuzz_message(RosSerialization::Ros1, evldt::kRos1EventArrayType, rest); break;
-    case 3: fuzz_message(RosSerialization::Ros1, evldt::kRos1EventPacketType, rest); break;
-    case 4: fuzz_file(evldt::kAedat4Magic, rest, ".aedat4"); break;
-    case 5: fuzz_file(evldt::kMcapMagic, rest, ".mcap"); break;
-    case 6: fuzz_images(evldt::kAedat4Magic, rest, ".aedat4"); break;
-    case 7: fuzz_images(evldt::kAedat31Magic, rest, ".aedat"); break;
-    default: fuzz_images(evldt::kAedat2Magic, rest, ".aedat"); break;
+    case 0:
+      fuzz_message(RosSerialization::Cdr, evldt::kRos2EventPacketType, rest);
+      break;
+    case 1:
+      fuzz_message(RosSerialization::Cdr, evldt::kRos2EventArrayType, rest);
+      break;
+    case 2:
+      fuzz_message(RosSerialization::Ros1, evldt::kRos1EventArrayType, rest);
+      break;
+    case 3:
+      fuzz_message(RosSerialization::Ros1, evldt::kRos1EventPacketType, rest);
+      break;
+    case 4:
+      fuzz_file(evldt::kAedat4Magic, rest, ".aedat4");
+      break;
+    case 5:
+      fuzz_file(evldt::kMcapMagic, rest, ".mcap");
+      break;
+    case 6:
+      fuzz_images(evldt::kAedat4Magic, rest, ".aedat4");
+      break;
+    case 7:
+      fuzz_images(evldt::kAedat31Magic, rest, ".aedat");
+      break;
+    default:
+      fuzz_images(evldt::kAedat2Magic, rest, ".aedat");
+      break;
   }
   return 0;
 }

@@ -20,7 +20,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Accepted: then the generated decoder reads all of it (its forged-count hazard is excluded,
   // the counts having been checked) and finds the same message.
   evldt::event_batch_t generated;
-  require(generated.decode(data, 0, static_cast<int>(size)) == static_cast<int>(size), "lcm-gen refuses an accepted batch");
+  require(generated.decode(data, 0, static_cast<int>(size)) == static_cast<int>(size),
+          "lcm-gen refuses an accepted batch");
   require(generated.utime == header.utime && generated.epoch == header.epoch && generated.seq == header.seq &&
               generated.source == header.source && generated.width == header.width &&
               generated.height == header.height && generated.t_base_us == header.t_base_us &&

@@ -16,7 +16,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const evldt::SensorSize sensor = reader.sensor();
     evldt::EventBatch batch;
     while (reader.read(batch)) {
-      for (std::size_t i = 0; i < batch.size(); ++i) require(sensor.contains(batch.x[i], batch.y[i]), "event off the sensor");
+      for (std::size_t i = 0; i < batch.size(); ++i)
+        require(sensor.contains(batch.x[i], batch.y[i]), "event off the sensor");
     }
   } catch (const std::runtime_error&) {
     // No valid event batch in the file: refused with a message.

@@ -12,14 +12,16 @@
 
 namespace {
 
-constexpr std::array<const char*, 7> kEncodings = {"evt2", "evt3", "libcaer", "libcaer_cmp", "dv_events", "dvs_events", "mono"};
+constexpr std::array<const char*, 7> kEncodings = {"evt2",      "evt3",       "libcaer", "libcaer_cmp",
+                                                   "dv_events", "dvs_events", "mono"};
 
 struct Outcome {
   evldt::EventBatch events;
   std::string error;
 };
 
-Outcome decode(const char* encoding, std::int64_t time_base, std::span<const std::uint8_t> packet, std::size_t chunk_bytes) {
+Outcome decode(const char* encoding, std::int64_t time_base, std::span<const std::uint8_t> packet,
+               std::size_t chunk_bytes) {
   Outcome outcome;
   const auto decoder = evldt::make_packet_decoder(encoding, "fuzz");
   evldt::fuzz::require(decoder != nullptr, "no decoder for a listed encoding");
@@ -49,8 +51,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const std::int8_t polarity : whole.events.p) require(polarity == 1 || polarity == -1, "polarity not +-1");
   if (!whole_packets) {
     const Outcome chunked = decode(encoding, time_base, packet, std::size_t{data[0] / kEncodings.size()} + 1);
-    require(whole.events.t == chunked.events.t && whole.events.x == chunked.events.x && whole.events.y == chunked.events.y &&
-                whole.events.p == chunked.events.p,
+    require(whole.events.t == chunked.events.t && whole.events.x == chunked.events.x &&
+                whole.events.y == chunked.events.y && whole.events.p == chunked.events.p,
             "events depend on the chunk size");
     require(whole.error == chunked.error, "the error depends on the chunk size");
   }

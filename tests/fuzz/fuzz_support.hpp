@@ -40,8 +40,7 @@ void read_to_the_end(Reader& reader, Batch& batch) {
 class TempFile {
  public:
   TempFile(std::span<const std::uint8_t> bytes, const std::string& extension)
-      : path_(std::filesystem::temp_directory_path() /
-              ("evldt-fuzz-" + std::to_string(::getpid()) + extension)) {
+      : path_(std::filesystem::temp_directory_path() / ("evldt-fuzz-" + std::to_string(::getpid()) + extension)) {
     std::ofstream out(path_, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     require(static_cast<bool>(out), "cannot write the temporary file");

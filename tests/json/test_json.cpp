@@ -50,7 +50,8 @@ TEST(JsonQuoted, EscapesQuotesBackslashesAndControlCharactersOnly) {
   EXPECT_EQ(json_quoted("plain text"), "\"plain text\"");
   EXPECT_EQ(json_quoted("say \"hi\" \\ there"), "\"say \\\"hi\\\" \\\\ there\"");
   EXPECT_EQ(json_quoted("a\tb\rc\nd"), "\"a\\tb\\rc\\nd\"");
-  EXPECT_EQ(json_quoted(std::string_view("\x00\x1f\x7f", 3)), "\"\\u0000\\u001f\x7f\"");  // DEL is no control character in JSON
+  EXPECT_EQ(json_quoted(std::string_view("\x00\x1f\x7f", 3)),
+            "\"\\u0000\\u001f\x7f\"");  // DEL is no control character in JSON
   EXPECT_EQ(json_quoted("\xc3\xa9t\xc3\xa9 \xe2\x86\x92"), "\"\xc3\xa9t\xc3\xa9 \xe2\x86\x92\"");  // UTF-8 unchanged
 }
 

@@ -85,9 +85,9 @@ TEST(BendTest, ARoundMaySkipTheTest) {
 TEST(BendTest, StraightEdgesKeepTheirLinesAtCornersJunctionsAndNeighbours) {
   ScarfLattice lattice(kSensor, kBlock, 1.0);
   store(lattice, polyline({{40.3, 30.6}, {200.2, 30.6}, {200.2, 150.4}, {40.3, 150.4}, {40.3, 30.6}}));  // a box
-  store(lattice, polyline({{120.5, 30.6}, {120.5, 100.0}}));                         // a T on its top edge
-  store(lattice, polyline({{60.0, 60.2}, {180.0, 73.0}}));                           // a slanted edge
-  store(lattice, polyline({{60.0, 120.4}, {180.0, 120.4}}));                         // two edges 3 px apart
+  store(lattice, polyline({{120.5, 30.6}, {120.5, 100.0}}));  // a T on its top edge
+  store(lattice, polyline({{60.0, 60.2}, {180.0, 73.0}}));    // a slanted edge
+  store(lattice, polyline({{60.0, 120.4}, {180.0, 120.4}}));  // two edges 3 px apart
   store(lattice, polyline({{60.0, 123.4}, {180.0, 123.4}}));
   const std::vector<Segment> without_test = detect(lattice, 0.0f);
   ASSERT_GE(without_test.size(), 40u);

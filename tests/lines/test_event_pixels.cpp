@@ -15,7 +15,8 @@ bool any_within_by_scan(const ScarfLattice& lattice, Point2 at, float radius) {
   const float r = std::min(radius, 0.5f * static_cast<float>(lattice.geometry().block_size));
   const BlockEntries entries = lattice.entries(block);
   for (const LatticeEntry e : entries.entries) {
-    const float dx = static_cast<float>(entries.pixel_x(e)) - at.x(), dy = static_cast<float>(entries.pixel_y(e)) - at.y();
+    const float dx = static_cast<float>(entries.pixel_x(e)) - at.x(),
+                dy = static_cast<float>(entries.pixel_y(e)) - at.y();
     if (dx * dx + dy * dy <= r * r) return true;
   }
   return false;
@@ -30,13 +31,15 @@ TEST(EventPixels, AnswersAsAScanOfTheBlocksEntriesWouldAcrossSteps) {
   int hits = 0, asked = 0;
   for (int step = 0; step < 5; ++step) {
     // Each step changes the lattice: a map made at the last step must not answer for this one.
-    for (int i = 0; i < 400; ++i) lattice.insert(static_cast<std::uint16_t>(x_of(random)), static_cast<std::uint16_t>(y_of(random)));
+    for (int i = 0; i < 400; ++i)
+      lattice.insert(static_cast<std::uint16_t>(x_of(random)), static_cast<std::uint16_t>(y_of(random)));
     pixels.reset(&lattice);
     for (int q = 0; q < 2000; ++q) {
       const Point2 at(point_x(random), point_y(random));
       const float radius = radius_of(random);
       const bool expected = any_within_by_scan(lattice, at, radius);
-      ASSERT_EQ(pixels.any_within(at, radius), expected) << "at (" << at.x() << ", " << at.y() << "), radius " << radius;
+      ASSERT_EQ(pixels.any_within(at, radius), expected)
+          << "at (" << at.x() << ", " << at.y() << "), radius " << radius;
       hits += expected ? 1 : 0;
       ++asked;
     }

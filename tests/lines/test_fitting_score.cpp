@@ -38,10 +38,10 @@ TEST_F(FittingScoreTest, FullRowOfInliers) {
 TEST_F(FittingScoreTest, HalfOccupancyAndOutliersIgnored) {
   std::vector<LatticeEntry> points;
   for (int x = 4; x < 8; ++x) points.push_back(entry(x, 4));  // bins 0..3 -> r_o = 4/8
-  points.push_back(entry(5, 4));   // duplicate pixel: one more active inlier, same bin
-  points.push_back(entry(9, 6));   // 2 px off the line (d1 = 2 >= 1.6): outlier
-  points.push_back(entry(12, 4));  // centre at d2 = 8.5 > |L|: beyond the end
-  points.push_back(entry(3, 4));   // d2 = -0.5 < 0: before the start
+  points.push_back(entry(5, 4));                              // duplicate pixel: one more active inlier, same bin
+  points.push_back(entry(9, 6));                              // 2 px off the line (d1 = 2 >= 1.6): outlier
+  points.push_back(entry(12, 4));                             // centre at d2 = 8.5 > |L|: beyond the end
+  points.push_back(entry(3, 4));                              // d2 = -0.5 < 0: before the start
   const auto s = scorer.score(segment, point_set(points, false), 32.0f);
   EXPECT_FLOAT_EQ(s.occupancy, 0.5f);
   EXPECT_EQ(s.inliers, 5);

@@ -32,8 +32,8 @@ TEST(PointGrid, FarAndNonFinitePointsShareBorderCellsAndAreNotLost) {
   const float inf = std::numeric_limits<float>::infinity();
   const std::vector<Point2> points = {{0, 0}, {1e9f, 0}, {inf, 0}, {std::numeric_limits<float>::quiet_NaN(), 0}};
   PointGrid grid;
-  grid.build(1, points);  // 1024 cells wide at most, whatever the spread
-  EXPECT_EQ(near(grid, {0, 0}), (std::vector<std::uint32_t>{0, 3}));  // NaN: the first cell
+  grid.build(1, points);                                                 // 1024 cells wide at most, whatever the spread
+  EXPECT_EQ(near(grid, {0, 0}), (std::vector<std::uint32_t>{0, 3}));     // NaN: the first cell
   EXPECT_EQ(near(grid, {1e9f, 0}), (std::vector<std::uint32_t>{1, 2}));  // infinity: the border on its side
   grid.build(1, {});
   EXPECT_TRUE(near(grid, {0, 0}).empty());

@@ -78,9 +78,9 @@ TEST(LineMap, NoIdIsTakenOverAcrossTimeAngleOrOffset) {
   };
   const ReassociationParams defaults;
   EXPECT_FALSE(new_id_for({Point2(20, 15), Point2(28, 15)}, 100'000, defaults));
-  EXPECT_TRUE(new_id_for({Point2(20, 15), Point2(28, 15)}, 100'001, defaults));        // after the window
-  EXPECT_TRUE(new_id_for({Point2(20, 14), Point2(28, 16)}, 50'000, defaults));         // 14 degrees off
-  EXPECT_TRUE(new_id_for({Point2(20, 18.5f), Point2(28, 18.5f)}, 50'000, defaults));  // 4.5 px off
+  EXPECT_TRUE(new_id_for({Point2(20, 15), Point2(28, 15)}, 100'001, defaults));         // after the window
+  EXPECT_TRUE(new_id_for({Point2(20, 14), Point2(28, 16)}, 50'000, defaults));          // 14 degrees off
+  EXPECT_TRUE(new_id_for({Point2(20, 18.5f), Point2(28, 18.5f)}, 50'000, defaults));    // 4.5 px off
   EXPECT_TRUE(new_id_for({Point2(20, 15), Point2(28, 15)}, 50'000, {.window_us = 0}));  // switched off
   // Not a neighbour of the block it was released from.
   LineMap lines(kGeometry);
@@ -121,7 +121,7 @@ TEST(LineMap, OwnershipCollisionKeepsTheBetterLine) {
 
 TEST(LineMap, SuppressionProhibitsNearNeighboursForOneDetectionRound) {
   LineMap lines(kGeometry);
-  const int admin = kGeometry.index(2, 2);  // x [20, 28), y [20, 28)
+  const int admin = kGeometry.index(2, 2);                      // x [20, 28), y [20, 28)
   lines.add({Point2(21, 20), Point2(22, 28)}, 0.5f, admin, 0);  // centre (21.5, 24): 1.5 px from the left border
   lines.manage(kSuppressRatio);
   EXPECT_EQ(lines.block_status(kGeometry.index(1, 2)), BlockStatus::ProhibitDetection);
@@ -223,7 +223,8 @@ TEST(LineTracker, ReusingASettledLinesScoreChangesNothing) {
   std::size_t stored = 0, passes = 0;
   for (Timestamp t = 2000; t <= scene.duration_us; t += 2000) {
     const std::size_t end = std::lower_bound(events.t.begin(), events.t.end(), t) - events.t.begin();
-    lattice.insert(std::span(events.x).subspan(stored, end - stored), std::span(events.y).subspan(stored, end - stored));
+    lattice.insert(std::span(events.x).subspan(stored, end - stored),
+                   std::span(events.y).subspan(stored, end - stored));
     stored = end;
     if (t % 4000 == 0) {
       detect_reusing.detect(lattice, reusing, t);

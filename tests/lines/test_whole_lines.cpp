@@ -21,7 +21,7 @@ TrackedLine segment(std::uint64_t id, float x0, float y0, float x1, float y1) {
 /// Block segments along y = 20 + dy from x = 4 to 36 (ids 1-4), and a parallel edge 10 px below
 /// from x = 4 to 28 (ids 9-11).
 std::vector<TrackedLine> edge_pieces(float dy = 0) {
-  return {segment(1, 4, 20 + dy, 12, 20 + dy),   segment(2, 12, 20 + dy, 20, 20.5f + dy),
+  return {segment(1, 4, 20 + dy, 12, 20 + dy),     segment(2, 12, 20 + dy, 20, 20.5f + dy),
           segment(3, 20, 20.5f + dy, 28, 20 + dy), segment(4, 28, 20 + dy, 36, 20 + dy),
           segment(9, 4, 30 + dy, 12, 30 + dy),     segment(10, 12, 30 + dy, 20, 30 + dy),
           segment(11, 20, 30 + dy, 28, 30 + dy)};
@@ -134,7 +134,8 @@ TEST(WholeLineTracker, ARememberedEndDoesNotFollowALineThatTurned) {
   WholeLineTracker tracker(kBlock);
   tracker.update(0, pieces_along(20, 4, 52, 1));
   // What is left turns by 20 degrees (within the twice-as-loose bounds of former members).
-  const float c = std::cos(20.0f * std::numbers::pi_v<float> / 180), s = std::sin(20.0f * std::numbers::pi_v<float> / 180);
+  const float c = std::cos(20.0f * std::numbers::pi_v<float> / 180),
+              s = std::sin(20.0f * std::numbers::pi_v<float> / 180);
   std::vector<TrackedLine> turned;
   for (std::uint64_t k = 0; k < 3; ++k) {
     const float x0 = 4 + 8.0f * static_cast<float>(k) * c, y0 = 20 + 8.0f * static_cast<float>(k) * s;
@@ -152,9 +153,9 @@ TEST(WholeLineTracker, ARememberedEndDoesNotFollowALineThatTurned) {
 // a new id; along its last geometry it keeps them all.
 TEST(WholeLineTracker, ATiltedLongestSegmentDoesNotSteerALineOffItsEdge) {
   const auto edge = [](float y_end, float y_start) {
-    return std::vector<TrackedLine>{segment(538, 12, y_start, 20, y_end),   segment(392, 20, 41.1f, 28, 41.1f),
-                                    segment(368, 28, 39.7f, 36, 39.7f),     segment(314, 36, 38.0f, 44, 38.8f),
-                                    segment(308, 44, 36.5f, 52, 36.5f),     segment(282, 52, 34.9f, 60, 34.9f),
+    return std::vector<TrackedLine>{segment(538, 12, y_start, 20, y_end), segment(392, 20, 41.1f, 28, 41.1f),
+                                    segment(368, 28, 39.7f, 36, 39.7f),   segment(314, 36, 38.0f, 44, 38.8f),
+                                    segment(308, 44, 36.5f, 52, 36.5f),   segment(282, 52, 34.9f, 60, 34.9f),
                                     segment(450, 60, 33.1f, 68, 33.1f)};
   };
   WholeLineTracker tracker(kBlock);
@@ -177,8 +178,8 @@ TEST(WholeLineTracker, OfASplitLineTheLongerPartKeepsTheId) {
   // The middle turns away (an occluder's edge) and the right part now starts 40 px on, more than
   // even the 32 px gap a line's own segments may bridge; the left part (32 px) is longer than the
   // right (24 px).
-  const std::vector<TrackedLine> split = pieces_along(20, 4, 36, 1) + std::vector{segment(5, 36, 20, 42, 28)} +
-                                         pieces_along(20, 76, 100, 6);
+  const std::vector<TrackedLine> split =
+      pieces_along(20, 4, 36, 1) + std::vector{segment(5, 36, 20, 42, 28)} + pieces_along(20, 76, 100, 6);
   tracker.update(10, split);
   ASSERT_EQ(tracker.lines().size(), 2u);
   for (const WholeLine& l : tracker.lines()) {
@@ -255,7 +256,8 @@ TEST(WholeLineTracker, LinesWhoseEndsFallShortOfACornerMeetThere) {
   }
   // Nearly parallel lines make no corner: a line at 25 degrees to the horizontal one (too steep to
   // join it), its end 8 px on.
-  const float c = std::cos(25.0f * std::numbers::pi_v<float> / 180), s = std::sin(25.0f * std::numbers::pi_v<float> / 180);
+  const float c = std::cos(25.0f * std::numbers::pi_v<float> / 180),
+              s = std::sin(25.0f * std::numbers::pi_v<float> / 180);
   std::vector<TrackedLine> lines = pieces_along(20, 8, 40, 1);
   for (std::uint64_t k = 0; k < 4; ++k) {
     const float x0 = 48 + 8.0f * static_cast<float>(k) * c, y0 = 20 + 8.0f * static_cast<float>(k) * s;
@@ -290,7 +292,8 @@ TEST(WholeLineTracker, ALineLostForAMomentComesBackUnderItsIdButNotAfterKeepId) 
 
 /// pieces_along, every segment moving across itself at `velocity` px/s (down the image for
 /// positive: the pieces run left to right) and known to within `std`.
-std::vector<TrackedLine> moving_pieces(float y, float x0, float x1, std::uint64_t first_id, float velocity, float std = 20) {
+std::vector<TrackedLine> moving_pieces(float y, float x0, float x1, std::uint64_t first_id, float velocity,
+                                       float std = 20) {
   std::vector<TrackedLine> pieces = pieces_along(y, x0, x1, first_id);
   for (TrackedLine& piece : pieces) {
     piece.normal_velocity = velocity;
@@ -332,7 +335,8 @@ TEST(WholeLineTracker, ALinesVelocityIsItsSegmentsWeightedByHowWellEachIsKnown) 
   tracker.update(0, pieces);
   ASSERT_EQ(tracker.lines().size(), 1u);
   const WholeLine& line = tracker.lines()[0];
-  const float sign = line.segment.q1.x() > line.segment.q0.x() ? 1.0f : -1.0f;  // down the image for a line to the right
+  const float sign =
+      line.segment.q1.x() > line.segment.q0.x() ? 1.0f : -1.0f;  // down the image for a line to the right
   EXPECT_NEAR(sign * line.normal_velocity, 100.0f, 1.0f);
   // About the deviation of the mean of the two good ones, widened by the disagreement.
   EXPECT_GT(line.normal_velocity_std, 10.0f / std::sqrt(2.0f));

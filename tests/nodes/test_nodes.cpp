@@ -3,16 +3,16 @@
 
 #include <gtest/gtest.h>
 
+#include <sched.h>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <map>
-#include <sched.h>
 #include <lcm/lcm-cpp.hpp>
+#include <map>
 #include <mutex>
-#include <set>
 #include <opencv2/core.hpp>
+#include <set>
 #include <thread>
 
 #include "evldt/camera_info_t.hpp"
@@ -233,8 +233,8 @@ TEST(Nodes, CameraToLinesDeliversEveryBatchAndValidSegments) {
     fewer += joined.size() < list.segments.size() ? 1 : 0;
     previous_ids = ids;
   }
-  EXPECT_GT(fewer, both / 2);  // segments along one edge are joined
-  EXPECT_GT(continued, both);  // ids carry over from list to list
+  EXPECT_GT(fewer, both / 2);                      // segments along one edge are joined
+  EXPECT_GT(continued, both);                      // ids carry over from list to list
   EXPECT_GT(joined_segments, 0.6 * all_segments);  // most segments lie along published lines
 }
 
@@ -255,7 +255,8 @@ TEST(Nodes, CameraStatisticsCountTheWordsItsDecoderSkipped) {
   test_support::TempDir dir;
   const auto path = dir.file("padded.raw");
   EventBatch events;
-  for (int i = 0; i < 5000; ++i) events.push_back(1000 + 20 * i, static_cast<std::uint16_t>(i % 640), static_cast<std::uint16_t>(i % 480), 1);
+  for (int i = 0; i < 5000; ++i)
+    events.push_back(1000 + 20 * i, static_cast<std::uint16_t>(i % 640), static_cast<std::uint16_t>(i % 480), 1);
   std::vector<std::uint8_t> words;
   detail::make_evt3_encoder({640, 480})->encode(events, words);
   std::string file = "% format EVT3;height=480;width=640\n% end\n";
@@ -368,7 +369,8 @@ TEST(Nodes, ConfiguredSensorEngineServesTheFirstBatch) {
   std::size_t segments = 0;
   for (const auto& list : collector.lists()) {
     EXPECT_EQ(list.width, 240);
-    for (const auto& entry : list.segments) EXPECT_GE(static_cast<std::uint64_t>(entry.id), static_cast<std::uint64_t>(kEpoch));
+    for (const auto& entry : list.segments)
+      EXPECT_GE(static_cast<std::uint64_t>(entry.id), static_cast<std::uint64_t>(kEpoch));
     segments += list.segments.size();
   }
   EXPECT_GT(segments, 0u);
@@ -377,7 +379,9 @@ TEST(Nodes, ConfiguredSensorEngineServesTheFirstBatch) {
 // Records every CAMERA_INFO message of a camera.
 class CameraInfoCollector {
  public:
-  explicit CameraInfoCollector(lcm::LCM& lcm) { lcm.subscribe("CAMERA_INFO_CAM0", &CameraInfoCollector::on_info, this); }
+  explicit CameraInfoCollector(lcm::LCM& lcm) {
+    lcm.subscribe("CAMERA_INFO_CAM0", &CameraInfoCollector::on_info, this);
+  }
   void on_info(const lcm::ReceiveBuffer* buffer, const std::string&) {
     camera_info_t msg;
     const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size);
@@ -416,7 +420,8 @@ TEST(Nodes, WithACalibrationTheLinesComeWithTheirCamera) {
   // Until a list holds the last batch (every event stored), and the camera came twice.
   ASSERT_TRUE(wait_for([&] {
     const auto lists = collector.lists();
-    return cameras.infos().size() >= 2 && !lists.empty() && lists.back().newest_batch_seq == static_cast<std::int64_t>(sent.batches - 1);
+    return cameras.infos().size() >= 2 && !lists.empty() &&
+           lists.back().newest_batch_seq == static_cast<std::int64_t>(sent.batches - 1);
   }));
   lines.stop();
   const camera_info_t info = cameras.infos().back();
@@ -472,7 +477,8 @@ TEST(Nodes, CameraRestartBeginsAfreshWithoutRepeatingIds) {
   ASSERT_TRUE(wait_for([&] {
     const auto lists = collector.lists();
     return lines.node.totals().events_received == first.events_published + second.events_published &&
-           lists.size() > lists_before && lists.back().newest_batch_seq == static_cast<std::int64_t>(second.batches - 1) &&
+           lists.size() > lists_before &&
+           lists.back().newest_batch_seq == static_cast<std::int64_t>(second.batches - 1) &&
            lists.back().t_us < 200'000 + 1000;
   }));
   lines.stop();

@@ -167,7 +167,7 @@ TEST(Pipeline, RoundsRunOnEventTimeAndLongGapsAreSkipped) {
   batch.push_back(3600000000, 50, 50, 1);  // an hour later: only the rounds of the last 8 periods run
   pipeline.process(batch);
   EXPECT_EQ(pipeline.counters().events, 3u);
-  EXPECT_EQ(pipeline.counters().track_rounds, 4u + 9u);   // t - 8000 .. t inclusive
+  EXPECT_EQ(pipeline.counters().track_rounds, 4u + 9u);  // t - 8000 .. t inclusive
   EXPECT_EQ(pipeline.counters().detect_rounds, 2u + 5u);
   EXPECT_EQ(steps.size(), 4u + 9u);
   EXPECT_EQ(steps[3], 4000);
@@ -299,7 +299,8 @@ EngineCounters run_slowly(bool shedding) {
     engine.process(chunk);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    for (EngineCounters c = engine.counters(); c.tracked_us <= slice_end - 1 - track_period || c.detected_us <= slice_end - 1 - detect_period;
+    for (EngineCounters c = engine.counters();
+         c.tracked_us <= slice_end - 1 - track_period || c.detected_us <= slice_end - 1 - detect_period;
          c = engine.counters()) {
       if (std::chrono::steady_clock::now() > deadline) {
         ADD_FAILURE() << "no round due at " << slice_end - 1 << " us within a minute";

@@ -34,11 +34,12 @@ TEST(ShortIds, NumbersIdsInOrderOfFirstAppearanceAndKeepsThemWhileSeen) {
 TEST(ToggleLayer, EachKeyFlipsItsLayerAndOtherKeysNothing) {
   RenderOptions options;
   // By default: whole lines with their ids over segments without theirs, no grid.
-  EXPECT_TRUE(options.show_whole_lines && options.show_whole_line_ids && options.show_segments && !options.show_segment_ids);
+  EXPECT_TRUE(options.show_whole_lines && options.show_whole_line_ids && options.show_segments &&
+              !options.show_segment_ids);
   EXPECT_FALSE(options.show_grid);
   const std::vector<std::pair<int, bool RenderOptions::*>> keys = {
-      {'e', &RenderOptions::show_events},      {'s', &RenderOptions::show_segments},
-      {'b', &RenderOptions::show_bad_tracks},  {'w', &RenderOptions::show_whole_lines},
+      {'e', &RenderOptions::show_events},         {'s', &RenderOptions::show_segments},
+      {'b', &RenderOptions::show_bad_tracks},     {'w', &RenderOptions::show_whole_lines},
       {'i', &RenderOptions::show_whole_line_ids}, {'m', &RenderOptions::show_motion},
       {'n', &RenderOptions::show_segment_ids},    {'g', &RenderOptions::show_grid}};
   for (const auto& [key, shown] : keys) {
@@ -47,7 +48,8 @@ TEST(ToggleLayer, EachKeyFlipsItsLayerAndOtherKeysNothing) {
     EXPECT_NE(options.*shown, before.*shown) << static_cast<char>(key);
     for (const auto& [other_key, other] : keys) {
       if (other_key != key) {
-        EXPECT_EQ(options.*other, before.*other) << static_cast<char>(key) << " changed " << static_cast<char>(other_key);
+        EXPECT_EQ(options.*other, before.*other)
+            << static_cast<char>(key) << " changed " << static_cast<char>(other_key);
       }
     }
   }
@@ -55,8 +57,9 @@ TEST(ToggleLayer, EachKeyFlipsItsLayerAndOtherKeysNothing) {
   EXPECT_FALSE(toggle_layer(options, 'x'));
   EXPECT_FALSE(toggle_layer(options, -1));  // no key pressed
   for (const auto& [key, shown] : keys) EXPECT_EQ(options.*shown, before.*shown);
-  EXPECT_EQ(layer_key_help(), (std::vector<std::string>{"keys: e events", "s segments", "b bad tracks", "w whole lines", "i whole-line ids", "m motion",
-                                                        "n segment ids", "g block grid", "q quit"}));
+  EXPECT_EQ(layer_key_help(),
+            (std::vector<std::string>{"keys: e events", "s segments", "b bad tracks", "w whole lines",
+                                      "i whole-line ids", "m motion", "n segment ids", "g block grid", "q quit"}));
 }
 
 constexpr SensorSize kSensor{40, 30};
@@ -117,8 +120,9 @@ TEST(RenderScene, AWholeLinesMotionIsAnOrangeArrowWhereItMovesAndTheLayerHidesIt
 // The viz's status fields at a 240x180 sensor drawn at scale 1: wrapped, every line fits the
 // picture (drawn on one twice as wide, no text reaches past its width), fields whole and in order.
 TEST(StatusText, FieldsWrapToThePictureWidthWholeAndInOrder) {
-  const std::vector<std::string> fields = {"cam0", "t=12.345 s", "1.23 Mev/s", "57 lines", "9 whole", "detect 100 Hz", "track 500 Hz",
-                                           "latency 3.2/7.0 ms", "lost 0", "shed 0", "hot pixels 3"};
+  const std::vector<std::string> fields = {"cam0",    "t=12.345 s",    "1.23 Mev/s",   "57 lines",
+                                           "9 whole", "detect 100 Hz", "track 500 Hz", "latency 3.2/7.0 ms",
+                                           "lost 0",  "shed 0",        "hot pixels 3"};
   for (const int width : {240, 346, 640, 1280}) {
     const std::vector<std::string> lines = wrap_fields(fields, width);
     std::vector<std::string> rejoined;

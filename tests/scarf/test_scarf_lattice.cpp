@@ -66,7 +66,7 @@ TEST(ScarfLattice, ActiveInHomeBlockInactiveInThreeQuadrantNeighbours) {
 TEST(ScarfLattice, ActiveArrivalsCountTheActiveEntriesWrittenIntoABlock) {
   ScarfLattice lattice(kSensor, 8, 1.0);
   const auto g = lattice.geometry();
-  for (int k = 0; k < 100; ++k) lattice.insert(13, 21);  // active in block (1, 2), inactive in three others
+  for (int k = 0; k < 100; ++k) lattice.insert(13, 21);    // active in block (1, 2), inactive in three others
   EXPECT_EQ(lattice.active_arrivals(g.index(1, 2)), 100);  // all of them, past the ring's N = 32
   EXPECT_EQ(lattice.active_count(g.index(1, 2)), 32);
   EXPECT_EQ(lattice.active_arrivals(g.index(0, 2)), 0);    // inactive entries do not count
@@ -81,8 +81,7 @@ TEST(ScarfLattice, MarginPixelsAreOnlyInactive) {
   // Left margin, row 2 bottom half: blocks (0,2) and (0,3), inactive.
   EXPECT_EQ(blocks_written(0, 26), (std::set<std::pair<int, bool>>{{g.index(0, 2), false}, {g.index(0, 3), false}}));
   // Lattice edge column: the last block has no right neighbour.
-  EXPECT_EQ(blocks_written(59, 30),
-            (std::set<std::pair<int, bool>>{{g.index(6, 3), true}, {g.index(6, 2), false}}));
+  EXPECT_EQ(blocks_written(59, 30), (std::set<std::pair<int, bool>>{{g.index(6, 3), true}, {g.index(6, 2), false}}));
   // The last row of this sensor is still inside row 4's extended band.
   EXPECT_EQ(blocks_written(30, 47), (std::set<std::pair<int, bool>>{{g.index(3, 4), false}, {g.index(2, 4), false}}));
   // On a 70 px wide sensor the right margin is 10 px: its outer pixels belong to no block.
@@ -108,7 +107,8 @@ TEST(ScarfLattice, RingKeepsNewestNAndCountsActive) {
 
 TEST(ScarfLattice, CopyStateGivesAnIdenticalView) {
   ScarfLattice source(kSensor, 8, 1.0), copy(kSensor, 8, 1.0);
-  for (int k = 0; k < 500; ++k) source.insert(static_cast<std::uint16_t>(k * 7 % 64), static_cast<std::uint16_t>(k * 5 % 48));
+  for (int k = 0; k < 500; ++k)
+    source.insert(static_cast<std::uint16_t>(k * 7 % 64), static_cast<std::uint16_t>(k * 5 % 48));
   copy.copy_state_from(source);
   for (int block = 0; block < source.geometry().block_count(); ++block) {
     ASSERT_EQ(copy.active_count(block), source.active_count(block));
@@ -176,7 +176,8 @@ TEST(ScarfLattice, IncrementalCopyFollowsEveryChange) {
   ScarfLattice source(kSensor, 8, 1.0), view(kSensor, 8, 1.0);
   const auto write = [&](int count, int seed) {
     for (int k = 0; k < count; ++k) {
-      source.insert(static_cast<std::uint16_t>((k * 7 + seed) % 64), static_cast<std::uint16_t>((k * 5 + seed * 3) % 48));
+      source.insert(static_cast<std::uint16_t>((k * 7 + seed) % 64),
+                    static_cast<std::uint16_t>((k * 5 + seed * 3) % 48));
     }
   };
   write(500, 0);
@@ -251,7 +252,8 @@ TEST(ScarfLattice, ActiveEntriesPerBlockDoNotDependOnEdgeSpeed) {
         {Point2(20, 0), Point2(20, 180), Point2(speed, 0), 0, static_cast<Timestamp>(seconds * 1e6)}, sensor);
     lattice.insert(events);
     std::vector<int> counts;
-    for (int block = 0; block < lattice.geometry().block_count(); ++block) counts.push_back(lattice.active_count(block));
+    for (int block = 0; block < lattice.geometry().block_count(); ++block)
+      counts.push_back(lattice.active_count(block));
     return counts;
   };
   const auto slow = active_per_block(100.0f);

@@ -16,7 +16,9 @@ namespace {
 
 using Frame = std::vector<std::uint8_t>;
 
-std::size_t pixel_count(SensorSize sensor) { return static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height); }
+std::size_t pixel_count(SensorSize sensor) {
+  return static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height);
+}
 
 Frame uniform_frame(SensorSize sensor, std::uint8_t value) { return Frame(pixel_count(sensor), value); }
 

@@ -201,7 +201,8 @@ std::uint64_t fingerprint(const EventBatch& events) {
   };
   for (std::size_t i = 0; i < events.size(); ++i) {
     mix(static_cast<std::uint64_t>(events.t[i]));
-    mix(events.x[i] | static_cast<std::uint64_t>(events.y[i]) << 16 | static_cast<std::uint64_t>(events.p[i] & 0xFF) << 32);
+    mix(events.x[i] | static_cast<std::uint64_t>(events.y[i]) << 16 |
+        static_cast<std::uint64_t>(events.p[i] & 0xFF) << 32);
   }
   return hash;
 }
@@ -211,7 +212,8 @@ TEST(EventSimulator, AFlickeringLightFiresExactlyWhenItSwitches) {
   const EventBatch events = simulate(lamp({100, 0.25, 0.5}, 100'000), config);
   // Each switch crosses log(2) / 0.2 (about 3, with the threshold spread) thresholds at each of the 100 pixels.
   std::map<Timestamp, std::pair<int, int>> by_time;  // t -> (ON, OFF)
-  for (std::size_t i = 0; i < events.size(); ++i) (events.p[i] > 0 ? by_time[events.t[i]].first : by_time[events.t[i]].second)++;
+  for (std::size_t i = 0; i < events.size(); ++i)
+    (events.p[i] > 0 ? by_time[events.t[i]].first : by_time[events.t[i]].second)++;
   ASSERT_EQ(by_time.size(), 20u);  // on at 10, 20, ... 100 ms, off 2.5 ms after each on from 0 (the light starts on)
   for (const auto& [t, counts] : by_time) {
     const bool on = t % 10'000 == 0;
@@ -263,10 +265,11 @@ TEST(EventSimulator, ASaturatedReadoutDelaysJittersAndDropsButKeepsTimeOrder) {
 TEST(EventSimulator, TheBuiltInScenesOfEarlierReleasesGiveTheSameEvents) {
   // Fingerprints of the first 0.2 s of each scene at the default seed, as released before the
   // simulator learnt flicker, dark noise and readout: accuracy figures stay comparable.
-  const std::map<std::string, std::uint64_t> expected = {
-      {"three-lines-fast", 15295193216743789014ULL}, {"circle-board", 1042162683969142847ULL},
-      {"boxes-6dof", 8802692942234712056ULL},        {"multi-speed", 16935487906387197536ULL},
-      {"monitor-hd", 1436808431403419251ULL}};
+  const std::map<std::string, std::uint64_t> expected = {{"three-lines-fast", 15295193216743789014ULL},
+                                                         {"circle-board", 1042162683969142847ULL},
+                                                         {"boxes-6dof", 8802692942234712056ULL},
+                                                         {"multi-speed", 16935487906387197536ULL},
+                                                         {"monitor-hd", 1436808431403419251ULL}};
   for (const auto& [name, hash] : expected) {
     Scene scene = make_scene(name);
     scene.duration_us = 200'000;

@@ -19,8 +19,8 @@
 
 #include "evldt/events/event_stream_reader.hpp"
 #include "evldt/events/event_writer.hpp"
-#include "evldt/sim/scenes.hpp"
 #include "evldt/sim/event_simulator.hpp"
+#include "evldt/sim/scenes.hpp"
 #include "evldt/sources/event_source.hpp"
 #include "evldt/sources/live_bytes.hpp"
 #include "support/aedat31_network.hpp"
@@ -67,7 +67,9 @@ std::filesystem::path simulated_recording(const TempDir& dir) {
   return path;
 }
 
-std::filesystem::path real_recording(const char* name) { return std::filesystem::path(EVLDT_SHARED_DIR) / "real" / name; }
+std::filesystem::path real_recording(const char* name) {
+  return std::filesystem::path(EVLDT_SHARED_DIR) / "real" / name;
+}
 
 /// Sizes of random pieces (1 byte to 20 KiB), so pieces end inside words and headers.
 std::vector<std::size_t> random_pieces(std::size_t total, unsigned seed) {
@@ -287,8 +289,8 @@ TEST(TcpBytes, AStreamCutInsideAWordKeepsTheEventsBeforeIt) {
   const auto recording = simulated_recording(dir);
   std::vector<std::uint8_t> bytes = file_bytes(recording);
   bytes.resize(bytes.size() / 2 + 1);  // EVT 3.0 words are 2 bytes: the cut is inside one
-  std::ofstream(dir.file("cut.raw"), std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                                              static_cast<std::streamsize>(bytes.size()));
+  std::ofstream(dir.file("cut.raw"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   EventStreamReader cut_file(dir.file("cut.raw"));
   std::string file_error;
   const std::vector<Event> expected = all_events(cut_file, &file_error);
@@ -358,7 +360,8 @@ TEST(ReconnectingStream, WaitsForAServerNotYetUpAndStopEndsTheWait) {
   });
   const TcpAddress address = TcpAddress::parse(url);
   const double cpu_before = thread_cpu_seconds();
-  EXPECT_THROW((void)open_reconnecting([&] { return open_stream(std::make_unique<TcpBytes>(address, stop), std::nullopt, ""); }, stop),
+  EXPECT_THROW((void)open_reconnecting(
+                   [&] { return open_stream(std::make_unique<TcpBytes>(address, stop), std::nullopt, ""); }, stop),
                std::runtime_error);
   EXPECT_LT(thread_cpu_seconds() - cpu_before, 0.05) << "waiting between attempts must not spin";
   stopper.join();
@@ -386,7 +389,8 @@ TEST(DvNetworkStream, ARealRecordingStreamedWithADisconnectArrivesOnceEveryEvent
   server.serve_each({file.stream(0, middle), file.stream(middle, file.packets())});
   std::atomic<bool> stop{false};
   const TcpAddress address = TcpAddress::parse(server.url());
-  const auto source = open_reconnecting([&] { return open_dv_stream(std::make_unique<TcpBytes>(address, stop)); }, stop);
+  const auto source =
+      open_reconnecting([&] { return open_dv_stream(std::make_unique<TcpBytes>(address, stop)); }, stop);
   EXPECT_EQ(source->geometry(), sensor);  // from the stream's header
   std::vector<Event> got;
   EventBatch batch;

@@ -30,8 +30,9 @@ inline std::vector<std::uint8_t> aedat31_network_stream(std::span<const Event> e
     append_le(bytes, 1, 2);  // polarity events
     append_le(bytes, 1, 2);  // source id
     // event size, timestamp offset, overflow, capacity, number, valid
-    for (const std::uint64_t field : {std::uint64_t{8}, std::uint64_t{4}, static_cast<std::uint64_t>(events[begin].t >> 31),
-                                      std::uint64_t{count}, std::uint64_t{count}, std::uint64_t{count}}) {
+    for (const std::uint64_t field :
+         {std::uint64_t{8}, std::uint64_t{4}, static_cast<std::uint64_t>(events[begin].t >> 31), std::uint64_t{count},
+          std::uint64_t{count}, std::uint64_t{count}}) {
       append_le(bytes, field, 4);
     }
     for (std::size_t i = begin; i < end; ++i) {

@@ -86,12 +86,13 @@ int main(int argc, char** argv) {
   EventBatch events;
   simulator.run_until(scene.duration_us, events);
 
-  const char* info = R"(<dv version="2.0"><node name="outInfo" path="/mainloop/Recorder/outInfo/">)"
-                     R"(<node name="0" path="/mainloop/Recorder/outInfo/0/"><attr key="typeIdentifier" type="string">EVTS</attr>)"
-                     R"(<node name="info" path="/mainloop/Recorder/outInfo/0/info/"><attr key="sizeX" type="int">240</attr>)"
-                     R"(<attr key="sizeY" type="int">180</attr><attr key="source" type="string">DAVIS240C_FIXTURE</attr></node></node>)"
-                     R"(<node name="1" path="/mainloop/Recorder/outInfo/1/"><attr key="typeIdentifier" type="string">FRME</attr></node>)"
-                     R"(</node></dv>)";
+  const char* info =
+      R"(<dv version="2.0"><node name="outInfo" path="/mainloop/Recorder/outInfo/">)"
+      R"(<node name="0" path="/mainloop/Recorder/outInfo/0/"><attr key="typeIdentifier" type="string">EVTS</attr>)"
+      R"(<node name="info" path="/mainloop/Recorder/outInfo/0/info/"><attr key="sizeX" type="int">240</attr>)"
+      R"(<attr key="sizeY" type="int">180</attr><attr key="source" type="string">DAVIS240C_FIXTURE</attr></node></node>)"
+      R"(<node name="1" path="/mainloop/Recorder/outInfo/1/"><attr key="typeIdentifier" type="string">FRME</attr></node>)"
+      R"(</node></dv>)";
   Bytes file(kAedat4Magic.begin(), kAedat4Magic.end());
   {
     flatbuffers::FlatBufferBuilder builder;
@@ -120,7 +121,8 @@ int main(int argc, char** argv) {
     flatbuffers::FlatBufferBuilder builder;
     std::vector<dv::Event> elements;
     for (std::size_t i = from; i < to; ++i) {
-      elements.emplace_back(events.t[i], static_cast<std::int16_t>(events.x[i]), static_cast<std::int16_t>(events.y[i]), events.p[i] > 0);
+      elements.emplace_back(events.t[i], static_cast<std::int16_t>(events.x[i]), static_cast<std::int16_t>(events.y[i]),
+                            events.p[i] > 0);
     }
     const auto events_packet = dv::CreateEventPacket(builder, builder.CreateVectorOfStructs(elements));
     if (aedat_library) {

@@ -23,7 +23,8 @@ class DvFraming {
     const std::size_t at = std::string_view("#!AER-DAT4.0\r\n").size();
     if (bytes_.size() < at + 4) return;
     const std::uint32_t size = load_le32(bytes_.data() + at);
-    header_.assign(bytes_.begin() + static_cast<std::ptrdiff_t>(at), bytes_.begin() + static_cast<std::ptrdiff_t>(at + 4 + size));
+    header_.assign(bytes_.begin() + static_cast<std::ptrdiff_t>(at),
+                   bytes_.begin() + static_cast<std::ptrdiff_t>(at + 4 + size));
     const auto* io = aedat4::GetSizePrefixedIOHeader(header_.data());
     const auto end = io->dataTablePosition() >= 0 ? static_cast<std::size_t>(io->dataTablePosition()) : bytes_.size();
     for (std::size_t packet = at + 4 + size; packet + 8 <= end;) {
@@ -46,8 +47,8 @@ class DvFraming {
 
  private:
   static std::uint32_t load_le32(const std::uint8_t* p) {
-    return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16 |
-           static_cast<std::uint32_t>(p[3]) << 24;
+    return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+           static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
   }
 
   std::vector<std::uint8_t> bytes_;

@@ -24,8 +24,8 @@ struct Probe {
   void on_list(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
     evldt::segment_list_t list;
     if (evldt::decode_message(payload_of(buffer), list) != evldt::WireError::None) return invalid(channel);
-    std::printf("list %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %d", evldt::wall_clock_us(), list.epoch,
-                list.seq, list.t_us, list.newest_batch_seq, list.num_segments);
+    std::printf("list %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %" PRId64 " %d", evldt::wall_clock_us(),
+                list.epoch, list.seq, list.t_us, list.newest_batch_seq, list.num_segments);
     for (const auto& segment : list.segments) std::printf(" %" PRId64, segment.id);
     std::printf("\n");
   }

@@ -11,7 +11,8 @@
 namespace evldt::test_support {
 
 /// Writes `bytes` on `channel` with the log time `t_us`; a failed write fails the test.
-inline void write_log_event(lcm::LogFile& log, std::int64_t t_us, const std::string& channel, std::span<const std::uint8_t> bytes) {
+inline void write_log_event(lcm::LogFile& log, std::int64_t t_us, const std::string& channel,
+                            std::span<const std::uint8_t> bytes) {
   lcm::LogEvent event{};
   event.timestamp = t_us;
   event.channel = channel;

@@ -37,8 +37,11 @@ int main(int argc, char** argv) {
         payload.resize(200);
         for (auto& byte : payload) byte = static_cast<std::uint8_t>(random());
         break;
-      case 1: break;  // empty
-      case 2: payload.assign(valid.begin(), valid.begin() + static_cast<std::ptrdiff_t>(valid.size() / 2)); break;
+      case 1:
+        break;  // empty
+      case 2:
+        payload.assign(valid.begin(), valid.begin() + static_cast<std::ptrdiff_t>(valid.size() / 2));
+        break;
       case 3: {
         payload = valid;
         // num_events sits right before the event arrays: forge it to 2^31 - 1.

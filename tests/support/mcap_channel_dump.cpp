@@ -13,8 +13,8 @@ int main(int argc, char** argv) {
   }
   try {
     const evldt::McapChannelMessages channel = evldt::read_mcap_channel(argv[1], argv[2]);
-    std::printf("%s %s %s %zu\n%s\n", channel.schema_name.c_str(), channel.schema_encoding.c_str(), channel.message_encoding.c_str(),
-                channel.messages.size(), channel.schema.c_str());
+    std::printf("%s %s %s %zu\n%s\n", channel.schema_name.c_str(), channel.schema_encoding.c_str(),
+                channel.message_encoding.c_str(), channel.messages.size(), channel.schema.c_str());
     for (const auto& message : channel.messages) std::printf("%s\n", message.data.c_str());
   } catch (const std::exception& error) {
     std::fprintf(stderr, "mcap_channel_dump: %s\n", error.what());

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
       distinct.insert(p[0] << 16 | p[1] << 8 | p[2]);
     }
   }
-  std::printf("%d %d %ld %ld %zu\n", picture.cols, picture.rows, static_cast<long>(picture.total()), near, distinct.size());
+  std::printf("%d %d %ld %ld %zu\n", picture.cols, picture.rows, static_cast<long>(picture.total()), near,
+              distinct.size());
   return 0;
 }

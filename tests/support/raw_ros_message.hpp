@@ -40,8 +40,11 @@ template <>
 struct Serializer<RawRosMessage> {
   template <typename Stream>
   static void write(Stream& stream, const RawRosMessage& message) {
-    std::memcpy(stream.advance(static_cast<std::uint32_t>(message.bytes.size())), message.bytes.data(), message.bytes.size());
+    std::memcpy(stream.advance(static_cast<std::uint32_t>(message.bytes.size())), message.bytes.data(),
+                message.bytes.size());
   }
-  static std::uint32_t serializedLength(const RawRosMessage& message) { return static_cast<std::uint32_t>(message.bytes.size()); }
+  static std::uint32_t serializedLength(const RawRosMessage& message) {
+    return static_cast<std::uint32_t>(message.bytes.size());
+  }
 };
 }  // namespace ros::serialization

@@ -51,12 +51,14 @@ class BagWriter {
   explicit BagWriter(const std::filesystem::path& path) {
     std::filesystem::remove(path);
     EXPECT_EQ(sqlite3_open(path.c_str(), &db_), SQLITE_OK);
-    exec("CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);"
-         "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL,"
-         " serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);"
-         "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data BLOB NOT NULL);"
-         "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
-         "INSERT INTO schema VALUES (3, 'humble');");
+    exec(
+        "CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);"
+        "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL,"
+        " serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);"
+        "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data "
+        "BLOB NOT NULL);"
+        "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
+        "INSERT INTO schema VALUES (3, 'humble');");
   }
   ~BagWriter() { sqlite3_close(db_); }
   void topic(int id, const std::string& name, const std::string& type) {
@@ -64,14 +66,18 @@ class BagWriter {
   }
   /// The definition of a type, as rosbag2 keeps them since Iron (table message_definitions).
   void definition(const std::string& type, const std::string& text) {
-    exec("CREATE TABLE IF NOT EXISTS message_definitions(id INTEGER PRIMARY KEY, topic_type TEXT NOT NULL,"
-         " encoding TEXT NOT NULL, encoded_message_definition TEXT NOT NULL, type_description_hash TEXT NOT NULL);");
-    exec("INSERT INTO message_definitions (topic_type, encoding, encoded_message_definition, type_description_hash) VALUES ('" +
-         type + "', 'ros2msg', '" + text + "', '')");
+    exec(
+        "CREATE TABLE IF NOT EXISTS message_definitions(id INTEGER PRIMARY KEY, topic_type TEXT NOT NULL,"
+        " encoding TEXT NOT NULL, encoded_message_definition TEXT NOT NULL, type_description_hash TEXT NOT NULL);");
+    exec(
+        "INSERT INTO message_definitions (topic_type, encoding, encoded_message_definition, type_description_hash) "
+        "VALUES ('" +
+        type + "', 'ros2msg', '" + text + "', '')");
   }
   void message(int topic_id, std::int64_t timestamp, const std::vector<std::uint8_t>& data) {
     sqlite3_stmt* statement = nullptr;
-    sqlite3_prepare_v2(db_, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)", -1, &statement, nullptr);
+    sqlite3_prepare_v2(db_, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)", -1, &statement,
+                       nullptr);
     sqlite3_bind_int(statement, 1, topic_id);
     sqlite3_bind_int64(statement, 2, timestamp);
     sqlite3_bind_blob(statement, 3, data.data(), static_cast<int>(data.size()), SQLITE_TRANSIENT);
@@ -80,7 +86,9 @@ class BagWriter {
   }
 
  private:
-  void exec(const std::string& sql) { EXPECT_EQ(sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql; }
+  void exec(const std::string& sql) {
+    EXPECT_EQ(sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql;
+  }
   sqlite3* db_ = nullptr;
 };
 

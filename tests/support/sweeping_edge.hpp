@@ -13,9 +13,9 @@
 namespace evldt::testing {
 
 struct SweepingEdge {
-  Point2 a;                ///< segment endpoints at time t_begin_us
+  Point2 a;  ///< segment endpoints at time t_begin_us
   Point2 b;
-  Point2 velocity_px_s;    ///< translation; its component along the edge normal must not be zero
+  Point2 velocity_px_s;  ///< translation; its component along the edge normal must not be zero
   Timestamp t_begin_us = 0;
   Timestamp t_end_us = 0;
 };
@@ -44,9 +44,8 @@ inline EventBatch sweep_events(const SweepingEdge& edge, SensorSize sensor) {
       fired.push_back({t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y)});
     }
   }
-  std::sort(fired.begin(), fired.end(), [](const Fired& l, const Fired& r) {
-    return std::tie(l.t, l.y, l.x) < std::tie(r.t, r.y, r.x);
-  });
+  std::sort(fired.begin(), fired.end(),
+            [](const Fired& l, const Fired& r) { return std::tie(l.t, l.y, l.x) < std::tie(r.t, r.y, r.x); });
   EventBatch batch;
   for (const Fired& f : fired) batch.push_back(f.t, f.x, f.y, 1);
   return batch;

@@ -3,23 +3,23 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <limits>
 #include <lcm/lcm-cpp.hpp>
+#include <limits>
 #include <random>
 #include <thread>
-#include <unistd.h>
 
 #include "evldt/client/line_subscriber.hpp"
 #include "evldt/transport/channels.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
-#include "evldt/transport/latency_budget.hpp"
 #include "evldt/transport/event_batcher.hpp"
+#include "evldt/transport/latency_budget.hpp"
 #include "evldt/transport/latency_tracker.hpp"
 #include "evldt/transport/lcm_log.hpp"
 #include "evldt/transport/lcm_log_reader.hpp"
@@ -170,8 +170,9 @@ TEST(Messages, SegmentListRoundTripKeepsEveryField) {
 }
 
 TEST(Messages, ASegmentWithoutAFiniteVelocityOrWithANegativeDeviationIsRefused) {
-  for (const auto& [velocity, deviation] : {std::pair(std::numeric_limits<float>::quiet_NaN(), 1.0f),
-                                            std::pair(std::numeric_limits<float>::infinity(), 1.0f), std::pair(5.0f, -1.0f)}) {
+  for (const auto& [velocity, deviation] :
+       {std::pair(std::numeric_limits<float>::quiet_NaN(), 1.0f),
+        std::pair(std::numeric_limits<float>::infinity(), 1.0f), std::pair(5.0f, -1.0f)}) {
     segment_list_t msg = make_list();
     msg.segments[1].normal_velocity = velocity;
     msg.segments[1].normal_velocity_std = deviation;
@@ -362,7 +363,8 @@ TEST(Messages, BatchSpanUpToInt32EitherWayIsEncodedAsLcmGenDoes) {
     events.push_back(base, 1, 2, 1);
     events.push_back(base + kMaxBatchSpanUs, 3, 4, -1);
     events.push_back(base - kMaxBatchSpanUs, 65535, 0, 1);  // out of order: encoded all the same
-    for (std::size_t i = 0; i < 37; ++i) events.push_back(base + static_cast<Timestamp>(i) * 70000, static_cast<std::uint16_t>(i * 1000), 719, -1);
+    for (std::size_t i = 0; i < 37; ++i)
+      events.push_back(base + static_cast<Timestamp>(i) * 70000, static_cast<std::uint16_t>(i * 1000), 719, -1);
     std::vector<std::uint8_t> bytes{1, 2, 3};
     encode_event_batch(make_batch(events, 1), events, bytes);
     EXPECT_EQ(bytes, encode(make_batch(events, 1))) << base;
@@ -486,7 +488,8 @@ TEST(EventBatcher, BatchesAsTheSingleBufferBatcherDidAcrossWindowAndSizeBoundari
         for (std::size_t i = 0; i < n; ++i) {
           t += std::uniform_int_distribution<Timestamp>(0, window * 3)(random);
           const Timestamp jitter = percent(random) < 5 ? std::uniform_int_distribution<Timestamp>(0, 3)(random) : 0;
-          chunk.push_back(t - jitter, static_cast<std::uint16_t>(i), static_cast<std::uint16_t>(round), i % 2 ? std::int8_t{1} : std::int8_t{-1});
+          chunk.push_back(t - jitter, static_cast<std::uint16_t>(i), static_cast<std::uint16_t>(round),
+                          i % 2 ? std::int8_t{1} : std::int8_t{-1});
         }
         reference.push(chunk);
         if (percent(random) < 50) {
@@ -731,7 +734,8 @@ TEST(LatencyBudget, ThinsWhatQueuedAndShedsWhatQueuedPastTheBudgetWhateverTheSen
     LatencyBudget budget(20);  // ms
     // Delivered in 0.3-0.5 ms; the sender's clock is `offset` behind ours.
     std::int64_t now = 10'000'000;
-    for (int i = 0; i < 100; ++i, now += 1000) EXPECT_EQ(budget.stride(now - offset - 300 - (i % 3) * 100, now), 1) << offset;
+    for (int i = 0; i < 100; ++i, now += 1000)
+      EXPECT_EQ(budget.stride(now - offset - 300 - (i % 3) * 100, now), 1) << offset;
     EXPECT_EQ(budget.stride(now - offset - 300 - 19'900, now), 1);  // queued 19.9 ms: all of it kept
     EXPECT_EQ(budget.stride(now - offset - 300 - 20'100, now), 2);  // past the budget: every 2nd
     EXPECT_EQ(budget.stride(now - offset - 300 - 30'100, now), 4);  // past 1.5 budgets: every 4th
@@ -753,7 +757,7 @@ TEST(LatencyBudget, ThinsWhatQueuedAndShedsWhatQueuedPastTheBudgetWhateverTheSen
 TEST(LatencyBudget, WhatQueuedWhileTheConsumerStartedIsNotLate) {
   LatencyBudget budget(20);
   std::int64_t now = 1'000'000;
-  const std::int64_t offset = 2'000'000;  // the sender's clock is ahead of ours
+  const std::int64_t offset = 2'000'000;                 // the sender's clock is ahead of ours
   EXPECT_EQ(budget.stride(now + offset - 400, now), 1);  // the first batch: the consumer starts on it
   // It takes 60 ms to start; 60 batches published meanwhile (one a millisecond) arrive together.
   now += 60'000;
@@ -858,9 +862,9 @@ TEST(EventBatchReceiver, RefusesSensorSizesBeyondTheLimitOrThatTheSubscriberCann
   // The subscriber (as evldt-lines does) accepts only sizes its lattice fits.
   EventBatchReceiver receiver(std::nullopt, 0, [](SensorSize size) { return size.width >= 28 && size.height >= 28; });
   EventBatch out;
-  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 0, 7, 5000, 180)), out));   // beyond kMaxSensorSide
-  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 1, 7, -240, 180)), out));   // negative
-  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 2, 7, 20, 20)), out));      // too small to use
+  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 0, 7, 5000, 180)), out));  // beyond kMaxSensorSide
+  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 1, 7, -240, 180)), out));  // negative
+  EXPECT_FALSE(receiver.receive(encode(make_batch(make_events(3), 2, 7, 20, 20)), out));     // too small to use
   EXPECT_FALSE(receiver.sensor().has_value());
   ASSERT_TRUE(receiver.receive(encode(make_batch(make_events(3), 3, 7, 240, 180)), out));
   EXPECT_EQ(receiver.sensor(), (SensorSize{240, 180}));
@@ -904,7 +908,8 @@ TEST(Pacer, UnlimitedSpeedNeverWaits) {
   const auto start = std::chrono::steady_clock::now();
   pacer.wait_until(0, stop);
   pacer.wait_until(3'600'000'000, stop);
-  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));  // not the hour; room for a loaded machine
+  EXPECT_LT(std::chrono::steady_clock::now() - start,
+            std::chrono::seconds(10));  // not the hour; room for a loaded machine
 }
 
 TEST(Pacer, AJumpOfEventTimeIsNotWaitedThrough) {
@@ -942,9 +947,8 @@ TEST(Pacer, WaitsForEventTimeAndHonoursStop) {
 class LcmLogFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("evldt_transport_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = std::filesystem::temp_directory_path() / ("evldt_transport_" + std::to_string(::getpid()) + "_" +
+                                                     ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
@@ -956,7 +960,8 @@ class LcmLogFiles : public ::testing::Test {
     lcm::LogFile log(path.string(), "w");
     EXPECT_TRUE(log.good());
     for (std::int64_t seq = 0; seq < 3; ++seq) {
-      test_support::write_log_event(log, seq, "EVENTS_CAM0", encode(make_batch(make_events(100, 1000 + seq * 1000, 10), seq)));
+      test_support::write_log_event(log, seq, "EVENTS_CAM0",
+                                    encode(make_batch(make_events(100, 1000 + seq * 1000, 10), seq)));
       test_support::write_log_event(log, seq, "EVENTS_CAM0", Bytes{9, 9, 9});
       test_support::write_log_event(log, seq, "EVENTS_CAM1", encode(make_batch(make_events(7, 0), seq)));
     }
@@ -1026,7 +1031,9 @@ TEST_F(LcmLogFiles, MissingOrForeignFilesAreClearErrors) {
 }  // namespace evldt
 
 namespace {
-std::vector<std::uint8_t> bytes_of(std::size_t size, std::uint8_t fill) { return std::vector<std::uint8_t>(size, fill); }
+std::vector<std::uint8_t> bytes_of(std::size_t size, std::uint8_t fill) {
+  return std::vector<std::uint8_t>(size, fill);
+}
 }  // namespace
 
 TEST(PayloadQueue, HandsOverPayloadsInOrderAndGrowsASlotForALargeOne) {
@@ -1114,7 +1121,8 @@ ReadLog read_log(const std::filesystem::path& path) {
   ReadLog result;
   while (reader.next(record)) {
     EXPECT_EQ(record.channel, "CH_" + std::to_string(record.number % 3));
-    EXPECT_EQ(record.data, std::vector<std::uint8_t>(static_cast<std::size_t>(record.number + 40), static_cast<std::uint8_t>(record.number)));
+    EXPECT_EQ(record.data, std::vector<std::uint8_t>(static_cast<std::size_t>(record.number + 40),
+                                                     static_cast<std::uint8_t>(record.number)));
     EXPECT_EQ(record.t_us, 1'600'000'000'000'000 + record.number * 1000);
     result.numbers.push_back(record.number);
   }

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 #include <httplib.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <atomic>
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <thread>
 
@@ -66,7 +66,8 @@ TEST_F(WebViewTest, CopiesPicturesOnlyWhileABrowserLooks) {
   ASSERT_EQ(picture->status, 200);
   EXPECT_EQ(picture->get_header_value("Content-Type"), "image/jpeg");
   EXPECT_EQ(picture->get_header_value("X-Picture"), "2");
-  const cv::Mat decoded = cv::imdecode(std::vector<std::uint8_t>(picture->body.begin(), picture->body.end()), cv::IMREAD_COLOR);
+  const cv::Mat decoded =
+      cv::imdecode(std::vector<std::uint8_t>(picture->body.begin(), picture->body.end()), cv::IMREAD_COLOR);
   ASSERT_EQ(decoded.size(), cv::Size(120, 90));
   const cv::Vec3b centre = decoded.at<cv::Vec3b>(45, 60);
   EXPECT_NEAR(centre[0], 200, 4);
@@ -88,7 +89,8 @@ TEST_F(WebViewTest, EachPictureIsEncodedOnceAndKeepsItsOwnPixelsWhileHeld) {
       const auto picture = client.Get("/picture.jpg");
       ASSERT_EQ(picture->status, 200);
       EXPECT_EQ(picture->get_header_value("X-Picture"), std::to_string(number));
-      const cv::Mat decoded = cv::imdecode(std::vector<std::uint8_t>(picture->body.begin(), picture->body.end()), cv::IMREAD_COLOR);
+      const cv::Mat decoded =
+          cv::imdecode(std::vector<std::uint8_t>(picture->body.begin(), picture->body.end()), cv::IMREAD_COLOR);
       EXPECT_NEAR(decoded.at<cv::Vec3b>(10, 10)[0], shade, 4) << "picture " << number;
     }
   }
@@ -100,8 +102,9 @@ TEST_F(WebViewTest, StatusJsonHasTheNewestStatusAndLayersEscaped) {
   view.publish(picture_of(0), {"cam0  t=1.000 s", "a \"quoted\" \\ field"}, layers());
   const auto status = client.Get("/status.json");
   ASSERT_EQ(status->status, 200);
-  EXPECT_EQ(status->body, R"({"picture": 1, "status": ["cam0  t=1.000 s", "a \"quoted\" \\ field"], "layers": [)"
-                          R"({"key": "e", "name": "events", "shown": true}, {"key": "g", "name": "block grid", "shown": false}]})");
+  EXPECT_EQ(status->body,
+            R"({"picture": 1, "status": ["cam0  t=1.000 s", "a \"quoted\" \\ field"], "layers": [)"
+            R"({"key": "e", "name": "events", "shown": true}, {"key": "g", "name": "block grid", "shown": false}]})");
 }
 
 TEST_F(WebViewTest, KeysOfTheLayersAreQueuedInOrderOthersRefused) {
@@ -112,7 +115,8 @@ TEST_F(WebViewTest, KeysOfTheLayersAreQueuedInOrderOthersRefused) {
   EXPECT_EQ(client.Post("/key/z", "", "text/plain")->status, 404);
   EXPECT_EQ(view.take_keys(), (std::vector<char>{'g', 'e'}));
   EXPECT_TRUE(view.take_keys().empty());
-  for (std::size_t i = 0; i < WebView::kMaxQueuedKeys; ++i) ASSERT_EQ(client.Post("/key/e", "", "text/plain")->status, 204);
+  for (std::size_t i = 0; i < WebView::kMaxQueuedKeys; ++i)
+    ASSERT_EQ(client.Post("/key/e", "", "text/plain")->status, 204);
   EXPECT_EQ(client.Post("/key/e", "", "text/plain")->status, 503);  // the viz is not taking them
   EXPECT_EQ(view.take_keys().size(), WebView::kMaxQueuedKeys);
   EXPECT_EQ(view.counts().keys, 2 + WebView::kMaxQueuedKeys);
@@ -160,7 +164,8 @@ TEST(WebView, APortInUseIsAnErrorNamingIt) {
     const WebView second(on_loopback(first.port()));
     FAIL() << "bound a port in use";
   } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find("127.0.0.1:" + std::to_string(first.port())), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("127.0.0.1:" + std::to_string(first.port())), std::string::npos)
+        << error.what();
   }
   EXPECT_EQ(first.url(), "http://127.0.0.1:" + std::to_string(first.port()) + "/");
 }

@@ -5,9 +5,9 @@
 // clock not to matter.
 // Every size runs in a child process of its own, so its peak RSS is its own.
 
-#include <CLI/CLI.hpp>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -25,9 +25,9 @@
 #include "evldt/pipeline/deterministic_pipeline.hpp"
 #include "evldt/pipeline/event_intake.hpp"
 #include "evldt/pipeline/whole_line_stage.hpp"
-#include "evldt/sources/event_source.hpp"
 #include "evldt/sim/event_simulator.hpp"
 #include "evldt/sim/scenes.hpp"
+#include "evldt/sources/event_source.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 #include "evldt/transport/messages.hpp"
 
@@ -63,19 +63,19 @@ struct Figures {
   Timing detect;                ///< per pass, every block free
   double active_points = 0;     ///< active entries in the lattice the passes see
   double lines_created = 0;
-  Timing track;                 ///< per pass
+  Timing track;  ///< per pass
   double lines_tracked = 0;
-  Timing whole;                 ///< per whole-line step, over the window's output steps from an empty state
-  double whole_lines = 0;       ///< published at the window's last step
-  Timing snapshot;              ///< per full lattice copy (the real-time loops' consistent view)
-  Timing snapshot_1ms;          ///< per update of a view after 1 ms of the scene's events
-  Timing filters;               ///< per event, the default noise filters from an empty state
-  Timing filters_setup;         ///< per chain: building the filters' empty state (a service does it once, at start)
-  Timing rectify;               ///< per event, moving it into the rectified image of a calibrated camera
-  Timing pipeline;              ///< per event, the whole deterministic pipeline from an empty state
-  Timing pipeline_unfiltered;   ///< the same without the noise filters
-  double lattice_mb = 0;        ///< one lattice's storage
-  double events_mb = 0;         ///< the simulated events (part of the RSS, not of evldt's state)
+  Timing whole;                ///< per whole-line step, over the window's output steps from an empty state
+  double whole_lines = 0;      ///< published at the window's last step
+  Timing snapshot;             ///< per full lattice copy (the real-time loops' consistent view)
+  Timing snapshot_1ms;         ///< per update of a view after 1 ms of the scene's events
+  Timing filters;              ///< per event, the default noise filters from an empty state
+  Timing filters_setup;        ///< per chain: building the filters' empty state (a service does it once, at start)
+  Timing rectify;              ///< per event, moving it into the rectified image of a calibrated camera
+  Timing pipeline;             ///< per event, the whole deterministic pipeline from an empty state
+  Timing pipeline_unfiltered;  ///< the same without the noise filters
+  double lattice_mb = 0;       ///< one lattice's storage
+  double events_mb = 0;        ///< the simulated events (part of the RSS, not of evldt's state)
   double peak_rss_mb = 0;
 };
 
@@ -102,8 +102,10 @@ Timing time_op(const BenchSettings& settings, const std::function<void()>& op) {
     for (std::size_t i = 0; i < calls; ++i) op();
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     if (elapsed >= settings.min_time_s || calls >= (std::size_t{1} << 30)) break;
-    calls = elapsed > 0 ? std::max(calls * 2, static_cast<std::size_t>(static_cast<double>(calls) * settings.min_time_s / elapsed * 1.2))
-                        : calls * 16;
+    calls = elapsed > 0
+                ? std::max(calls * 2,
+                           static_cast<std::size_t>(static_cast<double>(calls) * settings.min_time_s / elapsed * 1.2))
+                : calls * 16;
   }
   std::vector<double> per_call;
   for (int r = 0; r < settings.repeats; ++r) {
@@ -114,9 +116,7 @@ Timing time_op(const BenchSettings& settings, const std::function<void()>& op) {
   return median_timing(std::move(per_call));
 }
 
-Timing per_item(Timing t, double items) {
-  return {t.median / items, t.min / items, t.max / items};
-}
+Timing per_item(Timing t, double items) { return {t.median / items, t.min / items, t.max / items}; }
 
 double peak_rss_mb() {
   std::ifstream status("/proc/self/status");
@@ -173,7 +173,8 @@ Timing time_receive(const BenchSettings& settings, SensorSize sensor, const Even
 }
 
 /// Storing events in the lattice, from the batch's columns and from an array of structs.
-void measure_storage(const EventBatch& events, const PipelineConfig& config, const BenchSettings& settings, Figures& f) {
+void measure_storage(const EventBatch& events, const PipelineConfig& config, const BenchSettings& settings,
+                     Figures& f) {
   const SensorSize sensor = config.lattice.sensor;
   const double n = f.events;
   ScarfLattice lattice(sensor, config.lattice.block_size, config.lattice.alpha);
@@ -181,15 +182,16 @@ void measure_storage(const EventBatch& events, const PipelineConfig& config, con
   f.storage = per_item(time_op(settings, [&] { lattice.insert(events); }), n);
   std::vector<Event> structs(events.size());
   for (std::size_t i = 0; i < events.size(); ++i) structs[i] = events[i];
-  f.storage_aos = per_item(time_op(settings, [&] {
-                             for (const Event& e : structs) lattice.insert(e.x, e.y);
-                           }),
+  f.storage_aos = per_item(time_op(settings,
+                                   [&] {
+                                     for (const Event& e : structs) lattice.insert(e.x, e.y);
+                                   }),
                            n);
 }
 
 /// A detection pass with every block free, on the lattice at the window's end.
-void measure_detection(const ScarfLattice& state, const PipelineConfig& config, WorkerPool& pool, const BenchSettings& settings,
-                       Figures& f) {
+void measure_detection(const ScarfLattice& state, const PipelineConfig& config, WorkerPool& pool,
+                       const BenchSettings& settings, Figures& f) {
   LineMap detected(state.geometry());
   f.detect = time_op(settings, [&] {
     // A fresh detector with every block free: the most work a pass can have (a detector skips the
@@ -221,16 +223,18 @@ void measure_tracking(const DeterministicPipeline& busy, WorkerPool& pool, const
 
 /// The whole-line steps over the window's output steps, from an empty state.
 void measure_whole_lines(const std::vector<std::pair<Timestamp, std::vector<TrackedLine>>>& output_steps,
-                         const ScarfLattice& state, const PipelineConfig& config, const BenchSettings& settings, Figures& f) {
+                         const ScarfLattice& state, const PipelineConfig& config, const BenchSettings& settings,
+                         Figures& f) {
   BenchSettings replays = settings;
   replays.min_time_s = 0;  // a replay of every step is long enough
-  f.whole = per_item(time_op(replays, [&] {
-                       WholeLineStage whole(config);
-                       // Against the lattice at the window's end, as the service checks its gaps,
-                       // corners and remembered ends against its latest copy.
-                       for (const auto& [t, lines] : output_steps) whole.step(t, lines, &state);
-                       f.whole_lines = static_cast<double>(whole.lines().size());
-                     }),
+  f.whole = per_item(time_op(replays,
+                             [&] {
+                               WholeLineStage whole(config);
+                               // Against the lattice at the window's end, as the service checks its gaps,
+                               // corners and remembered ends against its latest copy.
+                               for (const auto& [t, lines] : output_steps) whole.step(t, lines, &state);
+                               f.whole_lines = static_cast<double>(whole.lines().size());
+                             }),
                      static_cast<double>(std::max<std::size_t>(output_steps.size(), 1)));
 }
 
@@ -251,13 +255,15 @@ void measure_snapshots(const EventBatch& events, const ScarfLattice& state, cons
   f.snapshot = {f.snapshot.median / 2, f.snapshot.min / 2, f.snapshot.max / 2};
   // Updates are timed one by one (the storage between them is not): each repeat stores the next
   // 1 ms chunks of the window and times the view update after each.
-  const std::size_t per_ms = std::max<std::size_t>(1, static_cast<std::size_t>(n * 1000.0 / static_cast<double>(settings.window_us)));
+  const std::size_t per_ms =
+      std::max<std::size_t>(1, static_cast<std::size_t>(n * 1000.0 / static_cast<double>(settings.window_us)));
   view.copy_state_from(live);
   std::vector<double> update_seconds;
   for (int r = 0; r < settings.repeats; ++r) {
     double total = 0;
     std::size_t updates = 0;
-    for (std::size_t begin = 0; begin < events.size() && (updates < 50 || total < settings.min_time_s); begin += per_ms) {
+    for (std::size_t begin = 0; begin < events.size() && (updates < 50 || total < settings.min_time_s);
+         begin += per_ms) {
       const std::size_t count = std::min(per_ms, events.size() - begin);
       live.insert(std::span(events.x).subspan(begin, count), std::span(events.y).subspan(begin, count));
       const auto update_start = Clock::now();
@@ -271,8 +277,8 @@ void measure_snapshots(const EventBatch& events, const ScarfLattice& state, cons
 }
 
 /// What a batch goes through before storage: the noise filters, and rectification.
-void measure_intake(const std::vector<EventBatch>& messages, const PipelineConfig& config, const BenchSettings& settings,
-                    Figures& f) {
+void measure_intake(const std::vector<EventBatch>& messages, const PipelineConfig& config,
+                    const BenchSettings& settings, Figures& f) {
   const SensorSize sensor = config.lattice.sensor;
   const double n = f.events;
   // A service builds its chain (and its zeroed per-pixel table) once, at start: that is timed apart
@@ -301,16 +307,17 @@ void measure_intake(const std::vector<EventBatch>& messages, const PipelineConfi
   PipelineConfig rectify_only = config;
   rectify_only.filters.chain.clear();
   rectify_only.rectification = rectification_table(lens, sensor);
-  f.rectify = per_item(time_op(settings, [&] {
-                         EventIntake intake(rectify_only);
-                         for (const EventBatch& message : messages) intake.prepare(message);
-                       }),
+  f.rectify = per_item(time_op(settings,
+                               [&] {
+                                 EventIntake intake(rectify_only);
+                                 for (const EventBatch& message : messages) intake.prepare(message);
+                               }),
                        n);
 }
 
 /// The whole deterministic pipeline, with and without the noise filters, from an empty state.
-void measure_pipeline(const std::vector<EventBatch>& messages, const PipelineConfig& config, const BenchSettings& settings,
-                      Figures& f) {
+void measure_pipeline(const std::vector<EventBatch>& messages, const PipelineConfig& config,
+                      const BenchSettings& settings, Figures& f) {
   BenchSettings once = settings;
   once.min_time_s = 0;  // a pass over the whole window is long enough
   const double n = f.events;
@@ -344,7 +351,8 @@ Figures measure(const SizeCase& size_case, const BenchSettings& settings) {
   DeterministicPipeline busy(config);
   std::vector<std::pair<Timestamp, std::vector<TrackedLine>>> output_steps;
   busy.set_output(10000, [&](const OutputStep& step) {
-    output_steps.emplace_back(step.t, std::vector<TrackedLine>(step.segments.lines().begin(), step.segments.lines().end()));
+    output_steps.emplace_back(step.t,
+                              std::vector<TrackedLine>(step.segments.lines().begin(), step.segments.lines().end()));
   });
   busy.process(events);
   const ScarfLattice& state = busy.lattice();
@@ -394,22 +402,28 @@ std::optional<Figures> measure_in_child(const SizeCase& size_case, const BenchSe
 }
 
 void print_header() {
-  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %9s %8s %8s %8s %8s %8s %10s %9s %9s %8s\n", "size", "scene", "Mev/s*",
-              "storage", "(AoS)", "receive", "detect", "ns/point", "track", "ns/line", "whole", "(lines)", "copy", "1ms-upd",
-              "filters", "rectify", "pipeline", "(no filt)", "lattice", "RSS");
-  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %9s %8s %8s %8s %8s %8s %10s %9s %9s %8s\n", "", "", "scene", "Mev/s",
-              "Mev/s", "Mev/s", "Hz", "(points)", "Hz", "(lines)", "Hz", "", "us", "us", "Mev/s", "Mev/s", "Mev/s", "Mev/s", "MB", "MB");
+  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %9s %8s %8s %8s %8s %8s %10s %9s %9s %8s\n", "size",
+              "scene", "Mev/s*", "storage", "(AoS)", "receive", "detect", "ns/point", "track", "ns/line", "whole",
+              "(lines)", "copy", "1ms-upd", "filters", "rectify", "pipeline", "(no filt)", "lattice", "RSS");
+  std::printf("%-9s %-17s %7s %9s %9s %9s %10s %11s %10s %12s %9s %8s %8s %8s %8s %8s %10s %9s %9s %8s\n", "", "",
+              "scene", "Mev/s", "Mev/s", "Mev/s", "Hz", "(points)", "Hz", "(lines)", "Hz", "", "us", "us", "Mev/s",
+              "Mev/s", "Mev/s", "Mev/s", "MB", "MB");
 }
 
 void print_row(const SizeCase& c, const Figures& f) {
   char points[32], lines[32];
-  std::snprintf(points, sizeof points, "%.1f (%.0f)", f.detect.median * 1e9 / std::max(f.active_points, 1.0), f.active_points);
-  std::snprintf(lines, sizeof lines, "%.0f (%.0f)", f.track.median * 1e9 / std::max(f.lines_tracked, 1.0), f.lines_tracked);
-  std::printf("%-9s %-17s %7.2f %9.1f %9.1f %9.1f %10.0f %11s %10.0f %12s %9.0f %8.0f %8.1f %8.1f %8.1f %8.1f %10.2f %9.2f %9.2f %8.0f\n",
-              c.label, c.scene, f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median,
-              1e-6 / f.receive.median, 1.0 / f.detect.median, points, 1.0 / f.track.median, lines, 1.0 / f.whole.median,
-              f.whole_lines, f.snapshot.median * 1e6, f.snapshot_1ms.median * 1e6,
-              1e-6 / f.filters.median, 1e-6 / f.rectify.median, 1e-6 / f.pipeline.median, 1e-6 / f.pipeline_unfiltered.median, f.lattice_mb, f.peak_rss_mb);
+  std::snprintf(points, sizeof points, "%.1f (%.0f)", f.detect.median * 1e9 / std::max(f.active_points, 1.0),
+                f.active_points);
+  std::snprintf(lines, sizeof lines, "%.0f (%.0f)", f.track.median * 1e9 / std::max(f.lines_tracked, 1.0),
+                f.lines_tracked);
+  std::printf(
+      "%-9s %-17s %7.2f %9.1f %9.1f %9.1f %10.0f %11s %10.0f %12s %9.0f %8.0f %8.1f %8.1f %8.1f %8.1f %10.2f %9.2f "
+      "%9.2f %8.0f\n",
+      c.label, c.scene, f.scene_rate_mev_s, 1e-6 / f.storage.median, 1e-6 / f.storage_aos.median,
+      1e-6 / f.receive.median, 1.0 / f.detect.median, points, 1.0 / f.track.median, lines, 1.0 / f.whole.median,
+      f.whole_lines, f.snapshot.median * 1e6, f.snapshot_1ms.median * 1e6, 1e-6 / f.filters.median,
+      1e-6 / f.rectify.median, 1e-6 / f.pipeline.median, 1e-6 / f.pipeline_unfiltered.median, f.lattice_mb,
+      f.peak_rss_mb);
   std::fflush(stdout);
 }
 
@@ -422,8 +436,9 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
                 const std::vector<std::pair<SizeCase, Figures>>& results) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path.string());
-  out << "{\n  \"repeats\": " << settings.repeats << ",\n  \"threads\": " << settings.threads << ",\n  \"min_time_s\": " << settings.min_time_s
-      << ",\n  \"window_us\": " << settings.window_us << ",\n  \"sizes\": [\n";
+  out << "{\n  \"repeats\": " << settings.repeats << ",\n  \"threads\": " << settings.threads
+      << ",\n  \"min_time_s\": " << settings.min_time_s << ",\n  \"window_us\": " << settings.window_us
+      << ",\n  \"sizes\": [\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const auto& [c, f] = results[i];
     out << "    {\n      \"size\": \"" << c.label << "\",\n      \"scene\": \"" << c.scene << "\",\n"
@@ -490,9 +505,10 @@ std::vector<std::filesystem::path> write_format_samples(const std::filesystem::p
   EventBatch events;
   simulator.run_until(scene.duration_us, events);
   std::vector<std::filesystem::path> paths;
-  for (const auto& [format, name] : {std::pair{EventFormat::Evt3, "sample.raw"}, std::pair{EventFormat::Evt2, "sample_evt2.raw"},
-                                     std::pair{EventFormat::Evt21, "sample_evt21.raw"}, std::pair{EventFormat::Dat, "sample.dat"},
-                                     std::pair{EventFormat::EcdText, "sample.txt"}}) {
+  for (const auto& [format, name] :
+       {std::pair{EventFormat::Evt3, "sample.raw"}, std::pair{EventFormat::Evt2, "sample_evt2.raw"},
+        std::pair{EventFormat::Evt21, "sample_evt21.raw"}, std::pair{EventFormat::Dat, "sample.dat"},
+        std::pair{EventFormat::EcdText, "sample.txt"}}) {
     EventWriter writer(dir / name, format, scene.sensor);
     writer.write(events);
     writer.close();
@@ -504,10 +520,11 @@ std::vector<std::filesystem::path> write_format_samples(const std::filesystem::p
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"evldt-bench: speed and memory of SCARF storage, a detection pass, a tracking pass, the lattice\n"
-               "snapshot and the whole deterministic pipeline at every sensor size, on one core (--threads: the\n"
-               "passes and rounds on more). Prints a table (medians over the repeats) and writes the figures as\n"
-               "JSON."};
+  CLI::App app{
+      "evldt-bench: speed and memory of SCARF storage, a detection pass, a tracking pass, the lattice\n"
+      "snapshot and the whole deterministic pipeline at every sensor size, on one core (--threads: the\n"
+      "passes and rounds on more). Prints a table (medians over the repeats) and writes the figures as\n"
+      "JSON."};
   BenchSettings settings;
   std::vector<std::string> sizes;
   std::filesystem::path json_path;
@@ -531,8 +548,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   app.add_option("--json", json_path, "Write the figures as JSON");
   std::string filters;
-  app.add_option("--filters", filters, "Noise filters of the filter and pipeline figures, in order, or none (default: the\n"
-                                       "configuration's; names: hot-pixel, background-activity, refractory, anti-flicker)");
+  app.add_option("--filters", filters,
+                 "Noise filters of the filter and pipeline figures, in order, or none (default: the\n"
+                 "configuration's; names: hot-pixel, background-activity, refractory, anti-flicker)");
   std::vector<std::filesystem::path> decode_files;
   app.add_option("--decode", decode_files,
                  "Instead: decoding speed of these recordings (any format evldt reads; none given: the same scene\n"
@@ -551,10 +569,11 @@ int main(int argc, char** argv) {
     settings.window_us = static_cast<Timestamp>(window_ms * 1e3);
     settings.min_time_s = min_time_ms * 1e-3;
     if (app.count("--filters") > 0) settings.filters = parse_filter_chain(filters);
-    std::printf("evldt-bench: %d thread(s) for the passes and rounds, medians of %d repeats; *scene = event rate of the\n"
-                "simulated scene; filters: %s\n",
-                settings.threads, settings.repeats,
-                settings.filters ? format_filter_chain(*settings.filters).c_str() : "the configuration's");
+    std::printf(
+        "evldt-bench: %d thread(s) for the passes and rounds, medians of %d repeats; *scene = event rate of the\n"
+        "simulated scene; filters: %s\n",
+        settings.threads, settings.repeats,
+        settings.filters ? format_filter_chain(*settings.filters).c_str() : "the configuration's");
     print_header();
     std::vector<std::pair<SizeCase, Figures>> results;
     bool failed = false;

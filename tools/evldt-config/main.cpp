@@ -19,9 +19,10 @@ std::string toml_value(const evldt::Parameter& parameter, const std::string& val
 
 int main(int argc, char** argv) {
   using namespace evldt;
-  CLI::App app{"evldt-config: the configuration of the line pipeline for a sensor size (--width and --height, or\n"
-               "--config FILE) and any parameters given, printed as TOML that --config takes back; or, with\n"
-               "--markdown, the page of every parameter with its range, unit and defaults (docs/configuration.md)."};
+  CLI::App app{
+      "evldt-config: the configuration of the line pipeline for a sensor size (--width and --height, or\n"
+      "--config FILE) and any parameters given, printed as TOML that --config takes back; or, with\n"
+      "--markdown, the page of every parameter with its range, unit and defaults (docs/configuration.md)."};
   PipelineOptions options;
   options.add_to(app);
   bool markdown = false;
@@ -38,9 +39,10 @@ int main(int argc, char** argv) {
     }
     const PipelineConfig config = options.resolve(*sensor);
     // config/<size>.toml are this output at the defaults (a test compares every size).
-    std::printf("# evldt's pipeline for a %dx%d sensor, written by evldt-config (docs/configuration.md).\n"
-                "# Keys are the long command-line flags; a flag given on the command line overrides the file.\n",
-                sensor->width, sensor->height);
+    std::printf(
+        "# evldt's pipeline for a %dx%d sensor, written by evldt-config (docs/configuration.md).\n"
+        "# Keys are the long command-line flags; a flag given on the command line overrides the file.\n",
+        sensor->width, sensor->height);
     for (const Parameter& parameter : pipeline_parameters()) {
       std::string value = parameter.value_in(config);
       if (parameter.flag == "width") value = std::to_string(sensor->width);

@@ -1,12 +1,12 @@
 // evldt-offline: the deterministic pipeline over a recording, a scene or a video, writing segments over time as CSV,
 // a summary, and optionally a rendered video or PNG frames.
 
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
-#include <spdlog/spdlog.h>
 
 #include "evldt/app/pipeline_options.hpp"
 #include "evldt/app/run_summary.hpp"
@@ -92,8 +92,9 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
       },
       /*whole_lines=*/whole_csv || frames.draws_whole_lines());
 
-  spdlog::info("{}: {}x{}, b={} N={} dq={} f_th={}", source.name(), sensor->width, sensor->height, config.lattice.block_size, pipeline.lattice().geometry().capacity,
-               config.track.perturbation_px, config.score.fit_threshold);
+  spdlog::info("{}: {}x{}, b={} N={} dq={} f_th={}", source.name(), sensor->width, sensor->height,
+               config.lattice.block_size, pipeline.lattice().geometry().capacity, config.track.perturbation_px,
+               config.score.fit_threshold);
 
   RunSummary summary;
   summary.input = source.name();
@@ -151,18 +152,20 @@ int run(const Options& options, const PipelineOptions& pipeline_options, const S
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"evldt-offline: detect and track line segments in an event recording or a built-in scene, deterministically.\n"
-               "Writes the segments over time as CSV (t_us,id,x0,y0,x1,y1,score,status,normal_velocity,normal_velocity_std)\n"
-               "and prints a summary.\n"
-               "Exit status: 0 done, 1 bad usage or configuration, 2 corrupt input (events before the fault processed)."};
+  CLI::App app{
+      "evldt-offline: detect and track line segments in an event recording or a built-in scene, deterministically.\n"
+      "Writes the segments over time as CSV (t_us,id,x0,y0,x1,y1,score,status,normal_velocity,normal_velocity_std)\n"
+      "and prints a summary.\n"
+      "Exit status: 0 done, 1 bad usage or configuration, 2 corrupt input (events before the fault processed)."};
   Options options;
   PipelineOptions pipeline_options;
   SourceOptions source_options;
   source_options.add_to(app);
   app.add_option("-o,--output", options.output, "Segment CSV to write")->capture_default_str();
-  app.add_option("--whole-lines", options.whole_lines,
-                 "Also write whole lines (collinear touching segments joined, with their own ids) as CSV in the segment "
-                 "format: score = segments joined, status good");
+  app.add_option(
+      "--whole-lines", options.whole_lines,
+      "Also write whole lines (collinear touching segments joined, with their own ids) as CSV in the segment "
+      "format: score = segments joined, status good");
   app.add_option("--output-period-us", options.output_period_us, "Event time between CSV rows of segments")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{1}, Timestamp{60'000'000}));
@@ -172,7 +175,9 @@ int main(int argc, char** argv) {
   app.add_option("--render-period-us", options.render_period_us, "Event time between rendered frames")
       ->capture_default_str()
       ->check(CLI::Range(Timestamp{1}, Timestamp{60'000'000}));
-  app.add_option("--render-scale", options.render.scale, "Zoom of rendered frames")->capture_default_str()->check(CLI::Range(1, 8));
+  app.add_option("--render-scale", options.render.scale, "Zoom of rendered frames")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 8));
   app.add_flag("!--no-whole-lines", options.render.show_whole_lines, "Rendered frames without the whole lines");
   app.add_flag("!--no-ids", options.render.show_whole_line_ids, "Rendered frames without the whole lines' ids");
   app.add_flag("--segment-ids", options.render.show_segment_ids, "Write the segments' ids on rendered frames too");

@@ -1,10 +1,10 @@
 #include "evldt/app/lcm_options.hpp"
 
+#include <spdlog/spdlog.h>
+#include <systemd/sd-daemon.h>
 #include <csignal>
 #include <cstdlib>
-#include <spdlog/spdlog.h>
 #include <stdexcept>
-#include <systemd/sd-daemon.h>
 
 #include "evldt/transport/channels.hpp"
 
@@ -35,7 +35,8 @@ std::string LcmOptions::effective_url() const {
   // A large socket buffer rides out scheduling hiccups at kHz batch rates; the kernel caps it at
   // net.core.rmem_max (see deploy/README.md).
   if (!url_.starts_with("udpm://") || url_.find("recv_buf_size") != std::string::npos) return url_;
-  return url_ + (url_.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=" + std::to_string(kReceiveBufferBytes);
+  return url_ + (url_.find('?') == std::string::npos ? "?" : "&") +
+         "recv_buf_size=" + std::to_string(kReceiveBufferBytes);
 }
 
 std::unique_ptr<lcm::LCM> LcmOptions::connect() const {

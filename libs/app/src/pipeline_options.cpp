@@ -1,10 +1,10 @@
 #include "evldt/app/pipeline_options.hpp"
 
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <spdlog/sinks/stdout_color_sinks.h>
-#include <spdlog/spdlog.h>
 #include <stdexcept>
 
 #include "evldt/app/parameters.hpp"
@@ -17,7 +17,8 @@ const CLI::Validator& finite_number() {
   static const CLI::Validator validator(
       [](std::string& text) -> std::string {
         double value = 0;
-        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "'" + text + "' is not a finite number";
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value))
+          return "'" + text + "' is not a finite number";
         return {};
       },
       "FINITE");
@@ -65,15 +66,23 @@ void PipelineOptions::add_to(CLI::App& app) {
     auto group = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == parameter.group; });
     if (group == groups.end()) {
       const std::string name(parameter.group);
-      groups.emplace_back(parameter.group, app.add_option_group(name, name == "Pipeline" ? "Line detection and tracking; unset values follow the sensor size (docs/configuration.md)"
-                                                                                         : "Run before storage, in the order given"));
+      groups.emplace_back(
+          parameter.group,
+          app.add_option_group(
+              name, name == "Pipeline"
+                        ? "Line detection and tracking; unset values follow the sensor size (docs/configuration.md)"
+                        : "Run before storage, in the order given"));
       group = std::prev(groups.end());
     }
     std::string help(parameter.help);
     if (!parameter.unit.empty()) help += " [" + std::string(parameter.unit) + "]";
     if (!parameter.default_text.empty()) help += " (default: " + std::string(parameter.default_text) + ")";
-    const char* type = parameter.type == Parameter::Type::Integer ? "INT" : parameter.type == Parameter::Type::Real ? "FLOAT" : "TEXT";
-    group->second->add_option("--" + std::string(parameter.flag), values_[i], help)->type_name(type)->check(checked(parameter));
+    const char* type = parameter.type == Parameter::Type::Integer ? "INT"
+                       : parameter.type == Parameter::Type::Real  ? "FLOAT"
+                                                                  : "TEXT";
+    group->second->add_option("--" + std::string(parameter.flag), values_[i], help)
+        ->type_name(type)
+        ->check(checked(parameter));
   }
 }
 
@@ -94,7 +103,8 @@ std::optional<SensorSize> PipelineOptions::sensor() const {
   if (values_.empty()) return std::nullopt;  // add_to was not called
   const auto& width = given("width");
   const auto& height = given("height");
-  if (width.has_value() != height.has_value()) throw std::invalid_argument("give both --width and --height, or neither");
+  if (width.has_value() != height.has_value())
+    throw std::invalid_argument("give both --width and --height, or neither");
   if (!width) return std::nullopt;
   return SensorSize{std::stoi(*width), std::stoi(*height)};
 }

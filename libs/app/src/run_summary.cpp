@@ -26,33 +26,41 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
   const double mev = static_cast<double>(counters.events) * 1e-6;
   std::fprintf(out, "evldt summary: %s\n", input.c_str());
   if (!input_error.empty()) std::fprintf(out, "  input error      %s\n", input_error.c_str());
-  std::fprintf(out, "  events           %" PRIu64 " read, %" PRIu64 " stored, %" PRIu64 " dropped as invalid (%" PRIu64
+  std::fprintf(out,
+               "  events           %" PRIu64 " read, %" PRIu64 " stored, %" PRIu64 " dropped as invalid (%" PRIu64
                " off-sensor, %" PRIu64 " time-backwards), %" PRIu64 " clock resets\n",
                events_read, counters.events, drops.total(), drops.off_sensor, drops.time_backwards, drops.clock_resets);
   if (filters == "none") {
     std::fprintf(out, "  filters          none\n");
   } else {
-    std::fprintf(out, "  filters          %s: %" PRIu64 " in, %" PRIu64 " passed; dropped %" PRIu64 " hot-pixel, %" PRIu64
+    std::fprintf(out,
+                 "  filters          %s: %" PRIu64 " in, %" PRIu64 " passed; dropped %" PRIu64 " hot-pixel, %" PRIu64
                  " background-activity, %" PRIu64 " refractory, %" PRIu64 " anti-flicker\n",
                  filters.c_str(), filtered.events_in, filtered.passed, filtered.hot_pixel, filtered.background_activity,
                  filtered.refractory, filtered.anti_flicker);
   }
   if (calibration != "none") {
-    std::fprintf(out, "  calibration      %s: %" PRIu64 " events left out, their pixel sees beyond the rectified image\n", calibration.c_str(),
-                 counters.off_rectified);
+    std::fprintf(out,
+                 "  calibration      %s: %" PRIu64 " events left out, their pixel sees beyond the rectified image\n",
+                 calibration.c_str(), counters.off_rectified);
   }
   if (decoded.skipped_words > 0 || decoded.trigger_events > 0) {
-    std::fprintf(out, "  decoding         %" PRIu64 " words of reserved or unknown types skipped, %" PRIu64 " trigger events\n",
-                 decoded.skipped_words, decoded.trigger_events);
+    std::fprintf(
+        out, "  decoding         %" PRIu64 " words of reserved or unknown types skipped, %" PRIu64 " trigger events\n",
+        decoded.skipped_words, decoded.trigger_events);
   }
-  std::fprintf(out, "  event time       %.3f s (%.2f Mev/s)\n", event_seconds, event_seconds > 0 ? mev / event_seconds : 0.0);
-  std::fprintf(out, "  wall time        %.3f s (%.2f Mev/s processed)\n", wall_seconds, wall_seconds > 0 ? mev / wall_seconds : 0.0);
+  std::fprintf(out, "  event time       %.3f s (%.2f Mev/s)\n", event_seconds,
+               event_seconds > 0 ? mev / event_seconds : 0.0);
+  std::fprintf(out, "  wall time        %.3f s (%.2f Mev/s processed)\n", wall_seconds,
+               wall_seconds > 0 ? mev / wall_seconds : 0.0);
   std::fprintf(out,
                "  rounds           %" PRIu64 " tracking, %" PRIu64 " detection, %" PRIu64 " skipped over gaps, %" PRIu64
                " schedule restarts (clock went back)\n",
                counters.track_rounds, counters.detect_rounds, counters.skipped_rounds, counters.clock_restarts);
-  std::fprintf(out, "  lines            %" PRIu64 " created, %" PRIu64 " detections took over a released line's id, %" PRIu64
-               " alive at the end\n", lines_created, lines_reassociated, lines_alive);
+  std::fprintf(out,
+               "  lines            %" PRIu64 " created, %" PRIu64 " detections took over a released line's id, %" PRIu64
+               " alive at the end\n",
+               lines_created, lines_reassociated, lines_alive);
   std::fprintf(out, "  released         ");
   for (int r = 0; r < kReleaseReasonCount; ++r) {
     std::fprintf(out, "%s%s %" PRIu64, r ? ", " : "", reason_name(static_cast<ReleaseReason>(r)).data(), released[r]);
@@ -63,8 +71,8 @@ void RunSummary::print(std::FILE* out, const std::string& csv_path) const {
   if (frames > 0) std::fprintf(out, ", %d frames rendered", frames);
   std::fprintf(out, "\n");
   if (!whole_lines_path.empty()) {
-    std::fprintf(out, "  whole lines      %" PRIu64 " ids, %" PRIu64 " CSV rows -> %s\n", whole_lines_created, whole_line_rows,
-                 whole_lines_path.c_str());
+    std::fprintf(out, "  whole lines      %" PRIu64 " ids, %" PRIu64 " CSV rows -> %s\n", whole_lines_created,
+                 whole_line_rows, whole_lines_path.c_str());
   }
 }
 
@@ -74,15 +82,18 @@ void RunSummary::write_json(const std::filesystem::path& path) const {
   out << "{\n  \"input\": " << json_quoted(input) << ",\n";
   out << "  \"input_error\": " << json_quoted(input_error) << ",\n";
   out << "  \"events_read\": " << events_read << ",\n  \"events_stored\": " << counters.events << ",\n";
-  out << "  \"dropped_off_sensor\": " << drops.off_sensor << ",\n  \"dropped_time_backwards\": " << drops.time_backwards << ",\n";
+  out << "  \"dropped_off_sensor\": " << drops.off_sensor << ",\n  \"dropped_time_backwards\": " << drops.time_backwards
+      << ",\n";
   out << "  \"clock_resets\": " << drops.clock_resets << ",\n";
   out << "  \"filters\": \"" << filters << "\",\n  \"filtered\": {\"events_in\": " << filtered.events_in
       << ", \"passed\": " << filtered.passed << ", \"hot_pixel\": " << filtered.hot_pixel
       << ", \"background_activity\": " << filtered.background_activity << ", \"refractory\": " << filtered.refractory
       << ", \"anti_flicker\": " << filtered.anti_flicker << "},\n";
-  out << "  \"skipped_words\": " << decoded.skipped_words << ",\n  \"trigger_events\": " << decoded.trigger_events << ",\n";
+  out << "  \"skipped_words\": " << decoded.skipped_words << ",\n  \"trigger_events\": " << decoded.trigger_events
+      << ",\n";
   out << "  \"event_seconds\": " << event_seconds << ",\n  \"wall_seconds\": " << wall_seconds << ",\n";
-  out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds << ",\n";
+  out << "  \"track_rounds\": " << counters.track_rounds << ",\n  \"detect_rounds\": " << counters.detect_rounds
+      << ",\n";
   out << "  \"skipped_rounds\": " << counters.skipped_rounds << ",\n";
   out << "  \"clock_restarts\": " << counters.clock_restarts << ",\n";
   out << "  \"events_off_rectified\": " << counters.off_rectified << ",\n";

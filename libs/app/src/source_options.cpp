@@ -8,32 +8,36 @@
 namespace evldt {
 
 void SourceOptions::add_to(CLI::App& app) {
-  app.add_option("input", recording_,
-                 "Recording: Prophesee RAW (EVT 2.0/2.1/3.0) or .dat, ECD events.txt, a ROS 1 or 2 bag (.bag, .db3, .mcap),\n"
-                 "AEDAT 2.0/3.1/4.0, Event Stream .es, HDF5 (DSEC, MVSEC, Metavision), or an lcm-log of event batches;\n"
-                 "the format and sensor size come from the file. Live: '-' (standard input), tcp://HOST:PORT or\n"
-                 "unix:///PATH: a stream of a RAW file (format from its header, else --format), or with --format aedat4\n"
-                 "DV's AEDAT 4.0 network output")
+  app.add_option(
+         "input", recording_,
+         "Recording: Prophesee RAW (EVT 2.0/2.1/3.0) or .dat, ECD events.txt, a ROS 1 or 2 bag (.bag, .db3, .mcap),\n"
+         "AEDAT 2.0/3.1/4.0, Event Stream .es, HDF5 (DSEC, MVSEC, Metavision), or an lcm-log of event batches;\n"
+         "the format and sensor size come from the file. Live: '-' (standard input), tcp://HOST:PORT or\n"
+         "unix:///PATH: a stream of a RAW file (format from its header, else --format), or with --format aedat4\n"
+         "DV's AEDAT 4.0 network output")
       ->check([](const std::string& input) -> std::string {
         if (input == "-" || input.starts_with("tcp://") || input.starts_with("unix://")) return {};
         return CLI::ExistingFile(input);
       });
   app.add_option("--follow", followed_,
-                 "Recording that a recorder is still writing (RAW, dat, ECD text, AEDAT 2.0/3.1, .es): events go out as it grows")
+                 "Recording that a recorder is still writing (RAW, dat, ECD text, AEDAT 2.0/3.1, .es): events go out "
+                 "as it grows")
       ->check(CLI::ExistingFile);
   app.add_option("--follow-idle-s", follow_idle_s_, "--follow ends once the file has not grown for this long")
       ->capture_default_str()
       ->check(finite_number() & CLI::Range(0.01, 86400.0));
-  app.add_flag("--reconnect", reconnect_,
-               "tcp:// and unix://: connect again when the server closes the stream, cuts it or cannot be reached (waits 0.1 s\n"
-               "doubling up to 2 s; counted); the run then ends only on SIGINT/SIGTERM");
+  app.add_flag(
+      "--reconnect", reconnect_,
+      "tcp:// and unix://: connect again when the server closes the stream, cuts it or cannot be reached (waits 0.1 s\n"
+      "doubling up to 2 s; counted); the run then ends only on SIGINT/SIGTERM");
   app.add_option("--format", format_,
                  "Recording format when the name or header does not tell: ecd, evt2, evt3, evt21, dat; aedat4: DV's\n"
                  "network stream on tcp:// or unix://")
       ->check(CLI::IsMember({"ecd", "evt2", "evt3", "evt21", "dat", "aedat4"}));
-  app.add_option("--lcm-channel,--topic", lcm_channel_,
-                 "Event channel of an lcm-log, topic of a bag or MCAP file, or event table of an HDF5 file (default: the\n"
-                 "first EVENTS_* channel / event topic / of /events, /davis/left/events, /CD/events)");
+  app.add_option(
+      "--lcm-channel,--topic", lcm_channel_,
+      "Event channel of an lcm-log, topic of a bag or MCAP file, or event table of an HDF5 file (default: the\n"
+      "first EVENTS_* channel / event topic / of /events, /davis/left/events, /CD/events)");
   app.add_option("--from-video", video_,
                  "Video file or webcam index: events by frame differencing (thresholds: --contrast, --contrast-sigma, "
                  "--refractory-us, --seed)");
@@ -65,17 +69,20 @@ std::unique_ptr<EventSource> SourceOptions::open(Timestamp backwards_slack_us, c
   const bool socket_input = recording_.starts_with("tcp://") || recording_.starts_with("unix://");
   std::optional<EventFormat> format;
   if (!format_.empty() && !dv_stream) format = parse_event_format(format_);
-  if (dv_stream && !socket_input) throw std::invalid_argument("--format aedat4 is for DV's network stream (tcp:// or unix://)");
+  if (dv_stream && !socket_input)
+    throw std::invalid_argument("--format aedat4 is for DV's network stream (tcp:// or unix://)");
   if (reconnect_ && !socket_input) throw std::invalid_argument("--reconnect is for a tcp:// or unix:// input");
   if (!followed_.empty()) {
-    return open_stream(std::make_unique<FollowedFileBytes>(followed_, std::chrono::duration<double>(follow_idle_s_), stop),
-                       format, followed_.extension().string());
+    return open_stream(
+        std::make_unique<FollowedFileBytes>(followed_, std::chrono::duration<double>(follow_idle_s_), stop), format,
+        followed_.extension().string());
   }
   if (recording_ == "-") return open_stream(std::make_unique<StdinBytes>(stop), format, "");
   const bool tcp = recording_.starts_with("tcp://"), unix_socket = recording_.starts_with("unix://");
   if (tcp || unix_socket) {
     // One connection's events: DV's AEDAT 4.0 network stream, or a stream in a recording format.
-    const auto open_connection = [url = recording_, tcp, dv = dv_stream, format, &stop]() -> std::unique_ptr<EventSource> {
+    const auto open_connection = [url = recording_, tcp, dv = dv_stream, format,
+                                  &stop]() -> std::unique_ptr<EventSource> {
       std::unique_ptr<ByteSource> bytes;
       if (tcp) {
         bytes = std::make_unique<TcpBytes>(TcpAddress::parse(url), stop);

@@ -23,7 +23,8 @@ CameraModel::Distortion distortion_of(const std::filesystem::path& path, const s
   }
   if (name == "equidistant" || name == "fisheye") return CameraModel::Distortion::Equidistant;
   if (name == "none") return CameraModel::Distortion::None;
-  fail(path, "distortion model '" + name + "' is not one evldt knows (plumb_bob, rational_polynomial, radtan, equidistant)");
+  fail(path,
+       "distortion model '" + name + "' is not one evldt knows (plumb_bob, rational_polynomial, radtan, equidistant)");
 }
 
 std::vector<double> numbers_of(const YAML::Node& node) {
@@ -36,14 +37,16 @@ std::vector<double> numbers_of(const YAML::Node& node) {
 CameraModel from_ros(const std::filesystem::path& path, const YAML::Node& root) {
   CameraModel model;
   model.format = "ROS camera_info";
-  if (root["image_width"] && root["image_height"]) model.size = {root["image_width"].as<int>(), root["image_height"].as<int>()};
+  if (root["image_width"] && root["image_height"])
+    model.size = {root["image_width"].as<int>(), root["image_height"].as<int>()};
   const std::vector<double> k = numbers_of(root["camera_matrix"]["data"]);
   if (k.size() != 9) fail(path, "camera_matrix.data must hold 9 numbers");
   model.fx = k[0];
   model.cx = k[2];
   model.fy = k[4];
   model.cy = k[5];
-  model.distortion = distortion_of(path, root["distortion_model"] ? root["distortion_model"].as<std::string>() : "plumb_bob");
+  model.distortion =
+      distortion_of(path, root["distortion_model"] ? root["distortion_model"].as<std::string>() : "plumb_bob");
   if (root["distortion_coefficients"]) model.coefficients = numbers_of(root["distortion_coefficients"]["data"]);
   return model;
 }
@@ -65,7 +68,8 @@ CameraModel from_kalibr(const std::filesystem::path& path, const YAML::Node& cam
     const std::vector<double> size = numbers_of(camera["resolution"]);
     if (size.size() == 2) model.size = {static_cast<int>(size[0]), static_cast<int>(size[1])};
   }
-  model.distortion = distortion_of(path, camera["distortion_model"] ? camera["distortion_model"].as<std::string>() : "none");
+  model.distortion =
+      distortion_of(path, camera["distortion_model"] ? camera["distortion_model"].as<std::string>() : "none");
   if (camera["distortion_coeffs"]) model.coefficients = numbers_of(camera["distortion_coeffs"]);
   return model;
 }
@@ -101,7 +105,8 @@ CameraModel from_opencv(const std::filesystem::path& path) {
   }
   std::string name;
   storage["distortion_model"] >> name;
-  model.distortion = name.empty() ? (model.coefficients.empty() ? CameraModel::Distortion::None : CameraModel::Distortion::RadialTangential)
+  model.distortion = name.empty() ? (model.coefficients.empty() ? CameraModel::Distortion::None
+                                                                : CameraModel::Distortion::RadialTangential)
                                   : distortion_of(path, name);
   return model;
 }
@@ -130,7 +135,8 @@ CameraModel from_ecd(const std::filesystem::path& path, const std::string& text)
   model.cx = values[2];
   model.cy = values[3];
   model.coefficients.assign(values.begin() + 4, values.end());
-  model.distortion = model.coefficients.empty() ? CameraModel::Distortion::None : CameraModel::Distortion::RadialTangential;
+  model.distortion =
+      model.coefficients.empty() ? CameraModel::Distortion::None : CameraModel::Distortion::RadialTangential;
   return model;
 }
 
@@ -149,7 +155,8 @@ void check(const std::filesystem::path& path, const CameraModel& model) {
   if (model.distortion == CameraModel::Distortion::Equidistant && n != 4) {
     fail(path, "equidistant distortion takes 4 coefficients, not " + std::to_string(n));
   }
-  if (model.size.width < 0 || model.size.height < 0 || model.size.width > kMaxSensorSide || model.size.height > kMaxSensorSide) {
+  if (model.size.width < 0 || model.size.height < 0 || model.size.width > kMaxSensorSide ||
+      model.size.height > kMaxSensorSide) {
     fail(path, "the image size is out of range");
   }
 }
@@ -158,9 +165,12 @@ void check(const std::filesystem::path& path, const CameraModel& model) {
 
 std::string distortion_name(CameraModel::Distortion distortion) {
   switch (distortion) {
-    case CameraModel::Distortion::None: return "none";
-    case CameraModel::Distortion::RadialTangential: return "radtan";
-    case CameraModel::Distortion::Equidistant: return "equidistant";
+    case CameraModel::Distortion::None:
+      return "none";
+    case CameraModel::Distortion::RadialTangential:
+      return "radtan";
+    case CameraModel::Distortion::Equidistant:
+      return "equidistant";
   }
   return "?";
 }
@@ -211,7 +221,9 @@ std::vector<float> undistorted_pixel_centres(const CameraModel& model, SensorSiz
   std::vector<cv::Point2d> rectified;
   const cv::Matx33d k(model.fx, 0, model.cx, 0, model.fy, model.cy, 0, 0, 1);
   switch (model.distortion) {
-    case CameraModel::Distortion::None: rectified = distorted; break;
+    case CameraModel::Distortion::None:
+      rectified = distorted;
+      break;
     case CameraModel::Distortion::RadialTangential:
       // The iterative inverse, run to convergence: the default 5 rounds leave tenths of a pixel at a
       // strong lens's corners.
@@ -233,8 +245,9 @@ std::vector<float> undistorted_pixel_centres(const CameraModel& model, SensorSiz
 
 std::shared_ptr<const RectificationTable> rectification_table(const CameraModel& model, SensorSize sensor) {
   if (model.size.width > 0 && !(model.size == sensor)) {
-    throw std::invalid_argument("the calibration is of a " + std::to_string(model.size.width) + "x" + std::to_string(model.size.height) +
-                                " camera, the sensor " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height));
+    throw std::invalid_argument("the calibration is of a " + std::to_string(model.size.width) + "x" +
+                                std::to_string(model.size.height) + " camera, the sensor " +
+                                std::to_string(sensor.width) + "x" + std::to_string(sensor.height));
   }
   // Per rectified pixel, where its centre lies on the sensor (OpenCV's maps: a pixel's centre at its
   // index), and so the sensor pixel that sees it.
@@ -242,7 +255,9 @@ std::shared_ptr<const RectificationTable> rectification_table(const CameraModel&
   const cv::Matx33d k(model.fx, 0, model.cx, 0, model.fy, model.cy, 0, 0, 1);
   cv::Mat map_x, map_y;
   switch (model.distortion) {
-    case CameraModel::Distortion::None: cv::initUndistortRectifyMap(k, cv::noArray(), cv::noArray(), k, size, CV_32FC1, map_x, map_y); break;
+    case CameraModel::Distortion::None:
+      cv::initUndistortRectifyMap(k, cv::noArray(), cv::noArray(), k, size, CV_32FC1, map_x, map_y);
+      break;
     case CameraModel::Distortion::RadialTangential:
       cv::initUndistortRectifyMap(k, model.coefficients, cv::noArray(), k, size, CV_32FC1, map_x, map_y);
       break;
@@ -250,17 +265,20 @@ std::shared_ptr<const RectificationTable> rectification_table(const CameraModel&
       cv::fisheye::initUndistortRectifyMap(k, model.coefficients, cv::Matx33d::eye(), k, size, CV_32FC1, map_x, map_y);
       break;
   }
-  std::vector<std::int32_t> sources(static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height), -1);
+  std::vector<std::int32_t> sources(static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height),
+                                    -1);
   for (int y = 0; y < sensor.height; ++y) {
     for (int x = 0; x < sensor.width; ++x) {
       const float sx = std::round(map_x.at<float>(y, x)), sy = std::round(map_y.at<float>(y, x));
-      if (!(sx >= 0 && sy >= 0 && sx < static_cast<float>(sensor.width) && sy < static_cast<float>(sensor.height))) continue;
+      if (!(sx >= 0 && sy >= 0 && sx < static_cast<float>(sensor.width) && sy < static_cast<float>(sensor.height)))
+        continue;
       sources[static_cast<std::size_t>(y) * static_cast<std::size_t>(sensor.width) + static_cast<std::size_t>(x)] =
           static_cast<std::int32_t>(sy) * sensor.width + static_cast<std::int32_t>(sx);
     }
   }
   auto table = std::make_shared<RectificationTable>(RectificationTable::from_sources(sensor, sources));
-  table->lens = {model.fx, model.fy, model.cx, model.cy, distortion_name(model.distortion), model.coefficients, model.path};
+  table->lens = {model.fx,           model.fy,  model.cx, model.cy, distortion_name(model.distortion),
+                 model.coefficients, model.path};
   return table;
 }
 

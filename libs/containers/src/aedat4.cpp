@@ -7,9 +7,9 @@
 #include <stdexcept>
 
 #include "aedat4_header_generated.h"
-#include "dv_frame_generated.h"
 #include "container_file.hpp"
 #include "decompress.hpp"
+#include "dv_frame_generated.h"
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_format.hpp"
 #include "evldt/events/size_prefixed_flatbuffer.hpp"
@@ -46,7 +46,8 @@ std::map<int, StreamInfo> parse_streams(std::string_view xml) {
     } else if (tag.starts_with("<attr")) {
       const auto value_end = xml.find("</attr>", close);
       if (value_end == std::string_view::npos) break;
-      attributes_by_path[path][std::string(attribute_of(tag, "key"))] = std::string(xml.substr(close + 1, value_end - close - 1));
+      attributes_by_path[path][std::string(attribute_of(tag, "key"))] =
+          std::string(xml.substr(close + 1, value_end - close - 1));
     }
   }
   std::map<int, StreamInfo> streams;
@@ -95,7 +96,8 @@ class Aedat4Container {
     header_at_ = file_.position();
     file_.read_exactly(header.data(), 4, "the header size");
     const std::uint32_t header_size = detail::load_le32(header.data());
-    if (header_size > detail::kMaxDecompressedBytes) throw FormatError(path_, file_.position() - 4, "header size " + std::to_string(header_size));
+    if (header_size > detail::kMaxDecompressedBytes)
+      throw FormatError(path_, file_.position() - 4, "header size " + std::to_string(header_size));
     header.resize(4 + header_size);
     file_.read_exactly(header.data() + 4, header_size, "the header");
     // The identifier "IOHE" is DV's; other writers leave it out, so it is not required. The verifier
@@ -107,8 +109,9 @@ class Aedat4Container {
     if (compression_ < aedat4::CompressionType::NONE || compression_ > aedat4::CompressionType::ZSTD_HIGH) {
       throw FormatError(path_, header_at_, "unknown compression " + std::to_string(static_cast<int>(compression_)));
     }
-    data_end_ = network_ ? std::numeric_limits<std::uint64_t>::max()
-                         : io->dataTablePosition() >= 0 ? static_cast<std::uint64_t>(io->dataTablePosition()) : file_.size();
+    data_end_ = network_                       ? std::numeric_limits<std::uint64_t>::max()
+                : io->dataTablePosition() >= 0 ? static_cast<std::uint64_t>(io->dataTablePosition())
+                                               : file_.size();
     streams_ = parse_streams(io->infoNode() ? io->infoNode()->string_view() : std::string_view());
   }
 
@@ -168,11 +171,17 @@ class Aedat4Container {
  private:
   void decompress(std::vector<std::uint8_t>& out) {
     switch (compression_) {
-      case aedat4::CompressionType::NONE: out = compressed_; return;
+      case aedat4::CompressionType::NONE:
+        out = compressed_;
+        return;
       case aedat4::CompressionType::LZ4:
-      case aedat4::CompressionType::LZ4_HIGH: detail::decompress_lz4_frame(compressed_, out); return;
+      case aedat4::CompressionType::LZ4_HIGH:
+        detail::decompress_lz4_frame(compressed_, out);
+        return;
       case aedat4::CompressionType::ZSTD:
-      case aedat4::CompressionType::ZSTD_HIGH: detail::decompress_zstd_frame(compressed_, out); return;
+      case aedat4::CompressionType::ZSTD_HIGH:
+        detail::decompress_zstd_frame(compressed_, out);
+        return;
     }
   }
 
@@ -192,7 +201,8 @@ class Aedat4Source final : public PacketSource {
  public:
   Aedat4Source(std::unique_ptr<detail::ContainerInput> input, bool network) : container_(std::move(input), network) {
     const auto events = container_.stream_of_type("EVTS");
-    if (!events) throw FormatError(container_.path(), container_.header_at(), "no polarity event stream (EVTS) in the header");
+    if (!events)
+      throw FormatError(container_.path(), container_.header_at(), "no polarity event stream (EVTS) in the header");
     stream_id_ = events->first;
     sensor_ = events->second.sensor;
     camera_ = events->second.source;
@@ -211,7 +221,8 @@ class Aedat4Source final : public PacketSource {
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return sensor_; }
   [[nodiscard]] std::string camera() const override { return camera_; }
   [[nodiscard]] std::string description() const override {
-    return "AEDAT 4.0, stream " + std::to_string(stream_id_) + " (polarity events, " + container_.compression_name() + ")";
+    return "AEDAT 4.0, stream " + std::to_string(stream_id_) + " (polarity events, " + container_.compression_name() +
+           ")";
   }
   [[nodiscard]] double progress() const override { return container_.progress(); }
   [[nodiscard]] std::uint64_t skipped_packets() const override { return container_.skipped_packets(); }
@@ -241,8 +252,13 @@ class Aedat4Images final : public ImageSource {
     if (frame == nullptr) throw std::runtime_error(location + ": not a valid Frame FlatBuffer");
     int channels = 1;
     switch (frame->format()) {
-      case dv::FrameFormat::OPENCV_8U_C1: image.encoding = "mono8"; break;
-      case dv::FrameFormat::OPENCV_8U_C3: image.encoding = "bgr8"; channels = 3; break;
+      case dv::FrameFormat::OPENCV_8U_C1:
+        image.encoding = "mono8";
+        break;
+      case dv::FrameFormat::OPENCV_8U_C3:
+        image.encoding = "bgr8";
+        channels = 3;
+        break;
       default:
         throw std::runtime_error(location + ": pixel format " + std::to_string(static_cast<int>(frame->format())) +
                                  " is not one evldt reads (grey or BGR, 8 bits)");
@@ -251,8 +267,8 @@ class Aedat4Images final : public ImageSource {
     const std::uint64_t height = frame->sizeY() > 0 ? static_cast<std::uint64_t>(frame->sizeY()) : 0;
     const std::uint64_t pixel_bytes = frame->pixels() ? frame->pixels()->size() : 0;
     if (width == 0 || height == 0 || pixel_bytes < width * height * static_cast<std::uint64_t>(channels)) {
-      throw std::runtime_error(location + ": " + std::to_string(pixel_bytes) + " bytes of pixels for a " + std::to_string(width) + "x" +
-                               std::to_string(height) + " frame");
+      throw std::runtime_error(location + ": " + std::to_string(pixel_bytes) + " bytes of pixels for a " +
+                               std::to_string(width) + "x" + std::to_string(height) + " frame");
     }
     // The middle of the exposure where the frame gives it; else its time stamp (its exposure's start).
     const std::int64_t start = frame->timestampStartOfExposure(), end = frame->timestampEndOfExposure();
@@ -286,6 +302,8 @@ std::unique_ptr<PacketSource> open_aedat4_stream(std::unique_ptr<ByteSource> byt
   return std::make_unique<Aedat4Source>(std::make_unique<detail::ContainerStream>(std::move(bytes)), true);
 }
 
-std::unique_ptr<ImageSource> open_aedat4_images(const std::filesystem::path& path) { return std::make_unique<Aedat4Images>(path); }
+std::unique_ptr<ImageSource> open_aedat4_images(const std::filesystem::path& path) {
+  return std::make_unique<Aedat4Images>(path);
+}
 
 }  // namespace evldt

@@ -47,21 +47,26 @@ class Aedat31Images final : public ImageSource {
         if (!read_frame_packet()) return false;
       }
       event = packet_.data() + next_event_ * event_size_;
-      location = path_ + ": frame " + std::to_string(next_event_++) + " of the frame packet at byte " + std::to_string(packet_at_);
+      location = path_ + ": frame " + std::to_string(next_event_++) + " of the frame packet at byte " +
+                 std::to_string(packet_at_);
       if ((detail::load_le32(event) & 1u) != 0) break;  // valid; an invalid one holds no frame
     }
     const std::uint32_t info = detail::load_le32(event);
     const std::uint32_t channels = (info >> 1) & 7u;
     const auto length_x = static_cast<std::int32_t>(detail::load_le32(event + 20));
     const auto length_y = static_cast<std::int32_t>(detail::load_le32(event + 24));
-    if (channels != 1) throw std::runtime_error(location + ": " + std::to_string(channels) + " colour channels (evldt reads grey frames)");
+    if (channels != 1)
+      throw std::runtime_error(location + ": " + std::to_string(channels) +
+                               " colour channels (evldt reads grey frames)");
     if (length_x <= 0 || length_y <= 0 ||
-        std::uint64_t{2} * static_cast<std::uint64_t>(length_x) * static_cast<std::uint64_t>(length_y) > event_size_ - kFrameHeaderBytes) {
-      throw std::runtime_error(location + ": a " + std::to_string(length_x) + "x" + std::to_string(length_y) + " frame does not fit its " +
-                               std::to_string(event_size_) + "-byte event");
+        std::uint64_t{2} * static_cast<std::uint64_t>(length_x) * static_cast<std::uint64_t>(length_y) >
+            event_size_ - kFrameHeaderBytes) {
+      throw std::runtime_error(location + ": a " + std::to_string(length_x) + "x" + std::to_string(length_y) +
+                               " frame does not fit its " + std::to_string(event_size_) + "-byte event");
     }
     // 31-bit times within the packet's overflow period, as the polarity events'.
-    const std::uint32_t start = detail::load_le32(event + 12) & 0x7FFFFFFFu, end = detail::load_le32(event + 16) & 0x7FFFFFFFu;
+    const std::uint32_t start = detail::load_le32(event + 12) & 0x7FFFFFFFu,
+                        end = detail::load_le32(event + 16) & 0x7FFFFFFFu;
     image.t_us = (Timestamp{overflow_} << 31) + start + (static_cast<Timestamp>(end) - start) / 2;
     image.width = static_cast<std::uint32_t>(length_x);
     image.height = static_cast<std::uint32_t>(length_y);
@@ -88,16 +93,21 @@ class Aedat31Images final : public ImageSource {
       const auto event_size = static_cast<std::int32_t>(detail::load_le32(header + 4));
       const auto capacity = static_cast<std::int32_t>(detail::load_le32(header + 16));
       if (event_size < 0 || capacity < 0) throw FormatError(path_, at, "packet with a negative size");
-      const std::uint64_t bytes = std::uint64_t(static_cast<std::uint32_t>(event_size)) * static_cast<std::uint32_t>(capacity);
+      const std::uint64_t bytes =
+          std::uint64_t(static_cast<std::uint32_t>(event_size)) * static_cast<std::uint32_t>(capacity);
       if (bytes > file_.size() - file_.position()) {
-        throw FormatError(path_, at, "packet of " + std::to_string(bytes) + " bytes does not fit in the file (a recording cut short)");
+        throw FormatError(
+            path_, at,
+            "packet of " + std::to_string(bytes) + " bytes does not fit in the file (a recording cut short)");
       }
       if (type != kFrameType) {  // events, IMU samples, a compressed packet (type bit 15): not frames
         file_.skip(bytes);
         continue;
       }
       if (static_cast<std::size_t>(event_size) < kFrameHeaderBytes) {
-        throw FormatError(path_, at, "frame packet with " + std::to_string(event_size) + "-byte events (a frame's header alone is 36)");
+        throw FormatError(
+            path_, at,
+            "frame packet with " + std::to_string(event_size) + "-byte events (a frame's header alone is 36)");
       }
       packet_.resize(bytes);
       file_.read_exactly(packet_.data(), packet_.size(), "a frame packet");
@@ -149,7 +159,9 @@ class Aedat2Images final : public ImageSource {
   }
 
   ~Aedat2Images() override {
-    if (skipped_frames_ > 0) spdlog::warn("{}: {} APS frame(s) incomplete (cut by the recording's start or a frame begun first), skipped", path_, skipped_frames_);
+    if (skipped_frames_ > 0)
+      spdlog::warn("{}: {} APS frame(s) incomplete (cut by the recording's start or a frame begun first), skipped",
+                   path_, skipped_frames_);
   }
 
   bool next(RecordingImage& image, std::string& location) override {
@@ -214,7 +226,8 @@ class Aedat2Images final : public ImageSource {
     image.big_endian = false;
     image.step = 2 * width_;
     image.data = frame_;
-    location = path_ + ": APS frame " + std::to_string(emitted_++) + " (ending at byte " + std::to_string(file_.position()) + ")";
+    location = path_ + ": APS frame " + std::to_string(emitted_++) + " (ending at byte " +
+               std::to_string(file_.position()) + ")";
   }
 
   detail::ContainerFile file_;
@@ -233,8 +246,12 @@ class Aedat2Images final : public ImageSource {
 
 }  // namespace
 
-std::unique_ptr<ImageSource> open_aedat31_images(const std::filesystem::path& path) { return std::make_unique<Aedat31Images>(path); }
+std::unique_ptr<ImageSource> open_aedat31_images(const std::filesystem::path& path) {
+  return std::make_unique<Aedat31Images>(path);
+}
 
-std::unique_ptr<ImageSource> open_aedat2_images(const std::filesystem::path& path) { return std::make_unique<Aedat2Images>(path); }
+std::unique_ptr<ImageSource> open_aedat2_images(const std::filesystem::path& path) {
+  return std::make_unique<Aedat2Images>(path);
+}
 
 }  // namespace evldt

@@ -9,7 +9,8 @@
 
 namespace evldt::detail {
 
-ContainerFile::ContainerFile(const std::filesystem::path& path, const std::string& kind) : stream_(path, std::ios::binary) {
+ContainerFile::ContainerFile(const std::filesystem::path& path, const std::string& kind)
+    : stream_(path, std::ios::binary) {
   path_ = path.string();
   if (!stream_) throw std::runtime_error("cannot open " + kind + " file '" + path_ + "'");
   std::error_code size_error;
@@ -17,7 +18,8 @@ ContainerFile::ContainerFile(const std::filesystem::path& path, const std::strin
 }
 
 void ContainerFile::read_exactly(void* out, std::size_t size, const char* what) {
-  if (!read_exactly_or_end(out, size, what)) throw FormatError(path_, position_, std::string("file ends inside ") + what);
+  if (!read_exactly_or_end(out, size, what))
+    throw FormatError(path_, position_, std::string("file ends inside ") + what);
 }
 
 bool ContainerFile::read_exactly_or_end(void* out, std::size_t size, const char* what) {
@@ -34,10 +36,13 @@ void ContainerFile::skip(std::uint64_t size) {
   position_ += size;
 }
 
-ContainerStream::ContainerStream(std::unique_ptr<ByteSource> bytes) : bytes_(std::move(bytes)) { path_ = bytes_->name(); }
+ContainerStream::ContainerStream(std::unique_ptr<ByteSource> bytes) : bytes_(std::move(bytes)) {
+  path_ = bytes_->name();
+}
 
 void ContainerStream::read_exactly(void* out, std::size_t size, const char* what) {
-  if (!read_exactly_or_end(out, size, what)) throw FormatError(path_, position_, std::string("stream ends inside ") + what);
+  if (!read_exactly_or_end(out, size, what))
+    throw FormatError(path_, position_, std::string("stream ends inside ") + what);
 }
 
 bool ContainerStream::read_exactly_or_end(void* out, std::size_t size, const char* what) {

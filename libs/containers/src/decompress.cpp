@@ -25,13 +25,16 @@ void grow(std::vector<std::uint8_t>& out) {
 
 void decompress_lz4_frame(std::span<const std::uint8_t> in, std::vector<std::uint8_t>& out) {
   LZ4F_dctx* context = nullptr;
-  if (LZ4F_isError(LZ4F_createDecompressionContext(&context, LZ4F_VERSION))) throw std::runtime_error("LZ4: out of memory");
-  const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> owner(context, LZ4F_freeDecompressionContext);
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&context, LZ4F_VERSION)))
+    throw std::runtime_error("LZ4: out of memory");
+  const std::unique_ptr<LZ4F_dctx, decltype(&LZ4F_freeDecompressionContext)> owner(context,
+                                                                                   LZ4F_freeDecompressionContext);
   start_output(in, out);
   std::size_t in_at = 0, out_at = 0;
   while (true) {
     std::size_t in_size = in.size() - in_at, out_size = out.size() - out_at;
-    const std::size_t hint = LZ4F_decompress(context, out.data() + out_at, &out_size, in.data() + in_at, &in_size, nullptr);
+    const std::size_t hint =
+        LZ4F_decompress(context, out.data() + out_at, &out_size, in.data() + in_at, &in_size, nullptr);
     if (LZ4F_isError(hint)) throw std::runtime_error(std::string("LZ4: ") + LZ4F_getErrorName(hint));
     in_at += in_size;
     out_at += out_size;
@@ -54,7 +57,8 @@ void decompress_zstd_frame(std::span<const std::uint8_t> in, std::vector<std::ui
     if (ZSTD_isError(hint)) throw std::runtime_error(std::string("Zstandard: ") + ZSTD_getErrorName(hint));
     out_at += output.pos;
     if (hint == 0) break;  // the frame is complete
-    if (input.pos == input.size && output.pos < output.size) throw std::runtime_error("Zstandard: the frame is cut short");
+    if (input.pos == input.size && output.pos < output.size)
+      throw std::runtime_error("Zstandard: the frame is cut short");
     if (out_at == out.size()) grow(out);
   }
   out.resize(out_at);

@@ -18,8 +18,8 @@
 namespace evldt {
 namespace {
 
-using hdf5::Handle;
 using hdf5::exists;
+using hdf5::Handle;
 using hdf5::hdf5_error;
 using hdf5::time_us;
 
@@ -56,9 +56,12 @@ void require_filters(hid_t dataset, const std::string& name) {
     H5Eclear2(H5E_DEFAULT);
     std::string hint;
     if (filter == kBloscFilter) hint = ": install Debian's hdf5-filter-plugin-blosc-serial";
-    if (filter == kEcfFilter) hint = ": Prophesee's ECF plugin (hdf5_ecf) is not packaged by Debian; install it and set HDF5_PLUGIN_PATH, or convert the file to RAW";
-    throw std::runtime_error(name + " is compressed with HDF5 filter " + std::to_string(filter) + " (" + filter_name.data() +
-                             "), which is not installed" + hint);
+    if (filter == kEcfFilter)
+      hint =
+          ": Prophesee's ECF plugin (hdf5_ecf) is not packaged by Debian; install it and set HDF5_PLUGIN_PATH, or "
+          "convert the file to RAW";
+    throw std::runtime_error(name + " is compressed with HDF5 filter " + std::to_string(filter) + " (" +
+                             filter_name.data() + "), which is not installed" + hint);
   }
 }
 
@@ -83,7 +86,8 @@ std::optional<SensorSize> sensor_from_attributes(hid_t object) {
     const Handle attribute(H5Aopen(object, "sensor_resolution", H5P_DEFAULT));
     const Handle space(H5Aget_space(attribute.get()));
     std::array<std::int64_t, 2> resolution{};
-    if (H5Sget_simple_extent_npoints(space.get()) == 2 && H5Aread(attribute.get(), H5T_NATIVE_INT64, resolution.data()) >= 0) {
+    if (H5Sget_simple_extent_npoints(space.get()) == 2 &&
+        H5Aread(attribute.get(), H5T_NATIVE_INT64, resolution.data()) >= 0) {
       return SensorSize{static_cast<int>(resolution[1]), static_cast<int>(resolution[0])};
     }
   }
@@ -104,14 +108,16 @@ std::optional<SensorSize> sensor_from_attributes(hid_t object) {
 
 // The file's values are untrusted: conversions saturate instead of overflowing, and a coordinate
 // outside 0..65535 (or NaN) becomes 65535, off every sensor, for the validator to drop and count.
-std::uint16_t coordinate(double value) { return value >= 0 && value <= 65535 ? static_cast<std::uint16_t>(std::lround(value)) : 65535; }
+std::uint16_t coordinate(double value) {
+  return value >= 0 && value <= 65535 ? static_cast<std::uint16_t>(std::lround(value)) : 65535;
+}
 
 Timestamp saturated_sum(Timestamp a, Timestamp b) {
   Timestamp sum = 0;
-  if (__builtin_add_overflow(a, b, &sum)) return b > 0 ? std::numeric_limits<Timestamp>::max() : std::numeric_limits<Timestamp>::min();
+  if (__builtin_add_overflow(a, b, &sum))
+    return b > 0 ? std::numeric_limits<Timestamp>::max() : std::numeric_limits<Timestamp>::min();
   return sum;
 }
-
 
 }  // namespace
 
@@ -140,7 +146,8 @@ struct Hdf5EventReader::Table {
   void select(hid_t dataset, std::size_t count, const Handle& memory, auto&& read) const {
     const Handle space(H5Dget_space(dataset));
     const std::array<hsize_t, 2> start{at, 0}, size{count, layout == Layout::Rows ? hsize_t{4} : hsize_t{1}};
-    if (H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, size.data(), nullptr) < 0 || read(memory.get(), space.get()) < 0) {
+    if (H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, size.data(), nullptr) < 0 ||
+        read(memory.get(), space.get()) < 0) {
       throw std::runtime_error(hdf5_error());
     }
   }
@@ -148,7 +155,8 @@ struct Hdf5EventReader::Table {
   void read_column(int column, hid_t type, void* out, std::size_t count) const {
     const hsize_t size = count;
     const Handle memory(H5Screate_simple(1, &size, nullptr));
-    select(columns[column].get(), count, memory, [&](hid_t m, hid_t f) { return H5Dread(columns[column].get(), type, m, f, H5P_DEFAULT, out); });
+    select(columns[column].get(), count, memory,
+           [&](hid_t m, hid_t f) { return H5Dread(columns[column].get(), type, m, f, H5P_DEFAULT, out); });
   }
 
   void read_slab(std::size_t count, EventBatch& out) {
@@ -164,26 +172,30 @@ struct Hdf5EventReader::Table {
           read_column(2, H5T_NATIVE_INT64, t.data(), count);
         }
         for (std::size_t i = 0; i < count; ++i) {
-          out.push_back(saturated_sum(time_offset_us, t[i]), coordinate(x[i]), coordinate(y[i]), p[i] > 0 ? std::int8_t{1} : std::int8_t{-1});
+          out.push_back(saturated_sum(time_offset_us, t[i]), coordinate(x[i]), coordinate(y[i]),
+                        p[i] > 0 ? std::int8_t{1} : std::int8_t{-1});
         }
         return;
       }
       case Layout::Rows: {
         const std::array<hsize_t, 2> size{count, 4};
         const Handle memory(H5Screate_simple(2, size.data(), nullptr));
-        select(columns[0].get(), count, memory,
-               [&](hid_t m, hid_t f) { return H5Dread(columns[0].get(), H5T_NATIVE_DOUBLE, m, f, H5P_DEFAULT, values.data()); });
+        select(columns[0].get(), count, memory, [&](hid_t m, hid_t f) {
+          return H5Dread(columns[0].get(), H5T_NATIVE_DOUBLE, m, f, H5P_DEFAULT, values.data());
+        });
         for (std::size_t i = 0; i < count; ++i) {
           const double* row = values.data() + 4 * i;
-          out.push_back(time_us(row[2], float_time), coordinate(row[0]), coordinate(row[1]), row[3] > 0 ? std::int8_t{1} : std::int8_t{-1});
+          out.push_back(time_us(row[2], float_time), coordinate(row[0]), coordinate(row[1]),
+                        row[3] > 0 ? std::int8_t{1} : std::int8_t{-1});
         }
         return;
       }
       case Layout::Records: {
         const hsize_t size = count;
         const Handle memory(H5Screate_simple(1, &size, nullptr));
-        select(columns[0].get(), count, memory,
-               [&](hid_t m, hid_t f) { return H5Dread(columns[0].get(), record_type.get(), m, f, H5P_DEFAULT, records.data()); });
+        select(columns[0].get(), count, memory, [&](hid_t m, hid_t f) {
+          return H5Dread(columns[0].get(), record_type.get(), m, f, H5P_DEFAULT, records.data());
+        });
         for (std::size_t i = 0; i < count; ++i) {
           const Record& record = records[i];
           out.push_back(time_us(record.t, float_time), coordinate(record.x), coordinate(record.y),
@@ -195,7 +207,8 @@ struct Hdf5EventReader::Table {
   }
 };
 
-Hdf5EventReader::Hdf5EventReader(const std::filesystem::path& path, const std::string& table) : table_(std::make_unique<Table>()), path_(path.string()) {
+Hdf5EventReader::Hdf5EventReader(const std::filesystem::path& path, const std::string& table)
+    : table_(std::make_unique<Table>()), path_(path.string()) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported by the exceptions thrown here
   Table& events = *table_;
   try {
@@ -210,7 +223,8 @@ Hdf5EventReader::Hdf5EventReader(const std::filesystem::path& path, const std::s
           break;
         }
       }
-      if (name.empty()) throw std::runtime_error("no event table (/events, /davis/left/events or /CD/events); name one with --topic");
+      if (name.empty())
+        throw std::runtime_error("no event table (/events, /davis/left/events or /CD/events); name one with --topic");
     } else if (!exists(file, name)) {
       throw std::runtime_error("no object " + name);
     }
@@ -223,7 +237,8 @@ Hdf5EventReader::Hdf5EventReader(const std::filesystem::path& path, const std::s
       const std::array<const char*, 4> column_names{"x", "y", "t", "p"};
       for (std::size_t i = 0; i < column_names.size(); ++i) {
         const std::string column = name + "/" + column_names[i];
-        if (!exists(file, column)) throw std::runtime_error(name + " is a group without the dataset " + column_names[i]);
+        if (!exists(file, column))
+          throw std::runtime_error(name + " is a group without the dataset " + column_names[i]);
         events.columns[i] = Handle(H5Dopen2(file, column.c_str(), H5P_DEFAULT));
         require_filters(events.columns[i].get(), column);
         const auto dims = shape(events.columns[i].get());
@@ -250,9 +265,11 @@ Hdf5EventReader::Hdf5EventReader(const std::filesystem::path& path, const std::s
       if (H5Tget_class(type.get()) == H5T_COMPOUND) {
         events.layout = Table::Layout::Records;
         for (const char* member : {"x", "y", "p", "t"}) {
-          if (H5Tget_member_index(type.get(), member) < 0) throw std::runtime_error(name + " has records without the field " + member);
+          if (H5Tget_member_index(type.get(), member) < 0)
+            throw std::runtime_error(name + " has records without the field " + member);
         }
-        const Handle t_type(H5Tget_member_type(type.get(), static_cast<unsigned>(H5Tget_member_index(type.get(), "t"))));
+        const Handle t_type(
+            H5Tget_member_type(type.get(), static_cast<unsigned>(H5Tget_member_index(type.get(), "t"))));
         events.float_time = H5Tget_class(t_type.get()) == H5T_FLOAT;
         events.record_type = Handle(H5Tcreate(H5T_COMPOUND, sizeof(Table::Record)));
         H5Tinsert(events.record_type.get(), "x", HOFFSET(Table::Record, x), H5T_NATIVE_INT32);
@@ -262,7 +279,9 @@ Hdf5EventReader::Hdf5EventReader(const std::filesystem::path& path, const std::s
         events.records.resize(kSlabEvents);
         what = "records x, y, p, t";
       } else {
-        if (dims[1] != 4) throw std::runtime_error(name + " is not a table of 4 columns (x, y, t, p) but of " + std::to_string(dims[1]));
+        if (dims[1] != 4)
+          throw std::runtime_error(name + " is not a table of 4 columns (x, y, t, p) but of " +
+                                   std::to_string(dims[1]));
         events.layout = Table::Layout::Rows;
         events.float_time = H5Tget_class(type.get()) == H5T_FLOAT;
         what = "rows x, y, t, p";
@@ -280,7 +299,8 @@ Hdf5EventReader::Hdf5EventReader(const std::filesystem::path& path, const std::s
     std::string size_note;
     if (!geometry_ && dataset_camera) {
       geometry_ = dataset_camera;
-      size_note = std::string("; ") + std::to_string(dataset_camera->width) + "x" + std::to_string(dataset_camera->height) + " as " +
+      size_note = std::string("; ") + std::to_string(dataset_camera->width) + "x" +
+                  std::to_string(dataset_camera->height) + " as " +
                   (dataset_camera->width == 640 ? "DSEC's" : "MVSEC's") + " cameras: not in the file";
     }
     if (geometry_ && !geometry_->valid()) geometry_.reset();

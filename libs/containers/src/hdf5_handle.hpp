@@ -43,10 +43,13 @@ class Handle {
 /// The innermost message of HDF5's error stack (the cause), for error messages of our own.
 inline std::string hdf5_error() {
   std::string message;
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, [](unsigned, const H5E_error2_t* error, void* out) -> herr_t {
-    if (error->desc && static_cast<std::string*>(out)->empty()) *static_cast<std::string*>(out) = error->desc;
-    return 0;
-  }, &message);
+  H5Ewalk2(
+      H5E_DEFAULT, H5E_WALK_UPWARD,
+      [](unsigned, const H5E_error2_t* error, void* out) -> herr_t {
+        if (error->desc && static_cast<std::string*>(out)->empty()) *static_cast<std::string*>(out) = error->desc;
+        return 0;
+      },
+      &message);
   H5Eclear2(H5E_DEFAULT);
   return message.empty() ? "HDF5 error" : message;
 }

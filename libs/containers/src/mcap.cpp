@@ -17,7 +17,14 @@ namespace evldt {
 namespace {
 
 // The record types read here (MCAP specification, major version 0); the others are skipped.
-enum Opcode : std::uint8_t { kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kChunk = 0x06, kDataEnd = 0x0F };
+enum Opcode : std::uint8_t {
+  kFooter = 0x02,
+  kSchema = 0x03,
+  kChannel = 0x04,
+  kMessage = 0x05,
+  kChunk = 0x06,
+  kDataEnd = 0x0F
+};
 
 /// Fields of a record's content: little-endian integers, strings and byte arrays with a length prefix.
 class FieldReader {
@@ -56,7 +63,7 @@ struct Record {
 
 struct Channel {
   std::string topic, type, encoding;
-  std::string definition;  // the schema's data: the .msg text of a ros1msg / ros2msg schema
+  std::string definition;                    // the schema's data: the .msg text of a ros1msg / ros2msg schema
   std::string schema_encoding, schema_data;  // of any schema
 };
 
@@ -81,8 +88,13 @@ class McapChannel {
  public:
   /// Whether a channel is one to read.
   using Accepts = std::function<bool(const Channel& channel)>;
-  McapChannel(const std::filesystem::path& path, const std::string& topic, Accepts accepts, std::string kind, std::string expected)
-      : file_(path, "MCAP"), path_(file_.path()), wanted_(topic), accepts_(std::move(accepts)), kind_(std::move(kind)),
+  McapChannel(const std::filesystem::path& path, const std::string& topic, Accepts accepts, std::string kind,
+              std::string expected)
+      : file_(path, "MCAP"),
+        path_(file_.path()),
+        wanted_(topic),
+        accepts_(std::move(accepts)),
+        kind_(std::move(kind)),
         expected_(std::move(expected)) {
     std::string magic(kMcapMagic.size(), '\0');
     file_.read_exactly(magic.data(), magic.size(), "the magic");
@@ -93,9 +105,11 @@ class McapChannel {
     if (channel_id_ < 0) {
       std::string listing;
       for (const auto& entry : channels_) {
-        listing += (listing.empty() ? "" : ", ") + entry.second.topic + " (" + entry.second.type + ", " + entry.second.encoding + ")";
+        listing += (listing.empty() ? "" : ", ") + entry.second.topic + " (" + entry.second.type + ", " +
+                   entry.second.encoding + ")";
       }
-      throw std::runtime_error("'" + path_ + "': " + (wanted_.empty() ? "no channel of " + kind_ : "no channel " + wanted_) +
+      throw std::runtime_error("'" + path_ +
+                               "': " + (wanted_.empty() ? "no channel of " + kind_ : "no channel " + wanted_) +
                                " (channels: " + (listing.empty() ? "none" : listing) + ")");
     }
   }
@@ -106,7 +120,8 @@ class McapChannel {
     Record record;
     while (next_record(record)) {
       if (!handle(record)) continue;
-      location = "message " + std::to_string(read_) + " of " + channel_.topic + " (record at byte " + std::to_string(record.offset) + ")";
+      location = "message " + std::to_string(read_) + " of " + channel_.topic + " (record at byte " +
+                 std::to_string(record.offset) + ")";
       offset = record.offset;
       try {
         FieldReader fields(record.content);
@@ -145,7 +160,8 @@ class McapChannel {
         record.opcode = header.read<std::uint8_t>();
         record.content = header.take(header.read<std::uint64_t>());
       } catch (const std::runtime_error&) {
-        throw FormatError(path_, chunk_offset_, "a record inside the chunk at byte " + std::to_string(chunk_offset_) + " runs past its end");
+        throw FormatError(path_, chunk_offset_,
+                          "a record inside the chunk at byte " + std::to_string(chunk_offset_) + " runs past its end");
       }
       record.offset = chunk_offset_;
       record.in_chunk = true;
@@ -155,13 +171,16 @@ class McapChannel {
     if (at_end_) return false;
     std::uint8_t header[9];
     record.offset = file_.position();
-    if (file_.position() == file_.size()) throw FormatError(path_, file_.position(), "file ends without its footer (a recording cut short)");
+    if (file_.position() == file_.size())
+      throw FormatError(path_, file_.position(), "file ends without its footer (a recording cut short)");
     file_.read_exactly(header, sizeof header, "a record header");
     FieldReader fields{std::span<const std::uint8_t>(header)};
     record.opcode = fields.read<std::uint8_t>();
     const auto length = fields.read<std::uint64_t>();
     if (length > file_.size() - file_.position() || length > detail::kMaxDecompressedBytes) {
-      throw FormatError(path_, record.offset, "record of " + std::to_string(length) + " bytes does not fit in the file (a recording cut short?)");
+      throw FormatError(
+          path_, record.offset,
+          "record of " + std::to_string(length) + " bytes does not fit in the file (a recording cut short?)");
     }
     file_record_.resize(length);
     file_.read_exactly(file_record_.data(), length, "a record");
@@ -185,7 +204,8 @@ class McapChannel {
           schema.name = fields.read_string();
           schema.encoding = fields.read_string();
           schema.data = fields.read_string();  // uint32-prefixed bytes, as a string is
-          schema.definition = schema.encoding == "ros1msg" || schema.encoding == "ros2msg" ? schema.data : std::string();
+          schema.definition =
+              schema.encoding == "ros1msg" || schema.encoding == "ros2msg" ? schema.data : std::string();
           return false;
         }
         case kChannel: {
@@ -214,13 +234,15 @@ class McapChannel {
           if (record.in_chunk) throw std::runtime_error("a chunk inside a chunk");
           open_chunk(fields, record.offset);
           return false;
-        default: return false;
+        default:
+          return false;
       }
     } catch (const FormatError&) {
       throw;
     } catch (const std::runtime_error& error) {
-      throw FormatError(path_, record.offset, "record type " + std::to_string(record.opcode) + " at byte " +
-                                                  std::to_string(record.offset) + ": " + error.what());
+      throw FormatError(path_, record.offset,
+                        "record type " + std::to_string(record.opcode) + " at byte " + std::to_string(record.offset) +
+                            ": " + error.what());
     }
   }
 
@@ -228,8 +250,8 @@ class McapChannel {
     if (channel_id_ >= 0 || (!wanted_.empty() && channel.topic != wanted_)) return;
     if (!accepts_(channel)) {
       if (wanted_.empty()) return;
-      throw std::runtime_error("'" + path_ + "': channel " + channel.topic + " is of type " + channel.type + " (" + channel.encoding +
-                               "), not " + expected_);
+      throw std::runtime_error("'" + path_ + "': channel " + channel.topic + " is of type " + channel.type + " (" +
+                               channel.encoding + "), not " + expected_);
     }
     channel_id_ = id;
     channel_ = channel;
@@ -251,7 +273,8 @@ class McapChannel {
       throw std::runtime_error("unknown chunk compression '" + compression + "'");
     }
     if (chunk_.size() != size) {
-      throw std::runtime_error("chunk holds " + std::to_string(chunk_.size()) + " bytes, its header says " + std::to_string(size));
+      throw std::runtime_error("chunk holds " + std::to_string(chunk_.size()) + " bytes, its header says " +
+                               std::to_string(size));
     }
     if (crc != 0 && crc32(0, chunk_.data(), static_cast<uInt>(chunk_.size())) != crc) {
       throw std::runtime_error("chunk CRC mismatch (a corrupt file)");
@@ -259,8 +282,6 @@ class McapChannel {
     chunk_at_ = 0;
     chunk_offset_ = offset;
   }
-
-
 
   detail::ContainerFile file_;
   std::string path_;
@@ -283,9 +304,13 @@ class McapChannel {
 class McapSource final : public PacketSource {
  public:
   McapSource(const std::filesystem::path& path, const std::string& topic)
-      : channel_(path, topic, [](const Channel& channel) {
-          return ros_serialized(channel) && RosEventLayout::of(ros_serialization(channel), channel.type, channel.definition).has_value();
-        }, "an event type", "an event type evldt reads"),
+      : channel_(
+            path, topic,
+            [](const Channel& channel) {
+              return ros_serialized(channel) &&
+                     RosEventLayout::of(ros_serialization(channel), channel.type, channel.definition).has_value();
+            },
+            "an event type", "an event type evldt reads"),
         layout_(*RosEventLayout::of(channel_.serialization(), channel_.type(), channel_.definition())) {}
 
   bool next(RecordingPacket& packet) override {
@@ -304,7 +329,9 @@ class McapSource final : public PacketSource {
 
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return std::nullopt; }  // in the messages
   [[nodiscard]] std::string camera() const override { return camera_; }
-  [[nodiscard]] std::string description() const override { return "MCAP, " + channel_.topic() + " (" + channel_.type() + ")"; }
+  [[nodiscard]] std::string description() const override {
+    return "MCAP, " + channel_.topic() + " (" + channel_.type() + ")";
+  }
   [[nodiscard]] double progress() const override { return channel_.progress(); }
   [[nodiscard]] std::uint64_t skipped_packets() const override { return channel_.skipped(); }
 
@@ -318,9 +345,12 @@ class McapSource final : public PacketSource {
 class McapImageSource final : public ImageSource {
  public:
   McapImageSource(const std::filesystem::path& path, const std::string& topic)
-      : channel_(path, topic, [](const Channel& channel) {
-          return ros_serialized(channel) && (channel.type == kRos2ImageType || channel.type == kRos1ImageType);
-        }, "type " + std::string(kRos2ImageType), std::string(kRos2ImageType)) {}
+      : channel_(
+            path, topic,
+            [](const Channel& channel) {
+              return ros_serialized(channel) && (channel.type == kRos2ImageType || channel.type == kRos1ImageType);
+            },
+            "type " + std::string(kRos2ImageType), std::string(kRos2ImageType)) {}
 
   bool next(RecordingImage& image, std::string& location) override {
     std::span<const std::uint8_t> message;
@@ -337,7 +367,9 @@ class McapImageSource final : public ImageSource {
     return true;
   }
 
-  [[nodiscard]] std::string description() const override { return "MCAP, " + channel_.topic() + " (" + channel_.type() + ")"; }
+  [[nodiscard]] std::string description() const override {
+    return "MCAP, " + channel_.topic() + " (" + channel_.type() + ")";
+  }
 
  private:
   McapChannel channel_;
@@ -354,7 +386,8 @@ std::unique_ptr<ImageSource> open_mcap_images(const std::filesystem::path& path,
 }
 
 McapChannelMessages read_mcap_channel(const std::filesystem::path& path, const std::string& topic) {
-  McapChannel reader(path, topic, [](const Channel&) { return true; }, "any type", "any type");
+  McapChannel reader(
+      path, topic, [](const Channel&) { return true; }, "any type", "any type");
   McapChannelMessages out;
   const Channel& channel = reader.channel();
   out.topic = channel.topic;
@@ -366,7 +399,8 @@ McapChannelMessages read_mcap_channel(const std::filesystem::path& path, const s
   std::string location;
   std::uint64_t offset = 0;
   while (reader.next(message, location, offset)) {
-    out.messages.push_back({reader.log_time_ns(), std::string(reinterpret_cast<const char*>(message.data()), message.size())});
+    out.messages.push_back(
+        {reader.log_time_ns(), std::string(reinterpret_cast<const char*>(message.data()), message.size())});
   }
   return out;
 }

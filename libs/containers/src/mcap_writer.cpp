@@ -10,7 +10,14 @@ namespace evldt {
 namespace {
 
 // Record types (MCAP specification).
-enum Opcode : std::uint8_t { kHeader = 0x01, kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kDataEnd = 0x0F };
+enum Opcode : std::uint8_t {
+  kHeader = 0x01,
+  kFooter = 0x02,
+  kSchema = 0x03,
+  kChannel = 0x04,
+  kMessage = 0x05,
+  kDataEnd = 0x0F
+};
 
 void put_le(std::string& out, std::uint64_t value, int bytes) {
   for (int i = 0; i < bytes; ++i) out += static_cast<char>(value >> (8 * i));
@@ -56,7 +63,8 @@ std::uint16_t McapWriter::add_schema(const std::string& name, const std::string&
   return id;
 }
 
-std::uint16_t McapWriter::add_channel(std::uint16_t schema, const std::string& topic, const std::string& message_encoding) {
+std::uint16_t McapWriter::add_channel(std::uint16_t schema, const std::string& topic,
+                                      const std::string& message_encoding) {
   if (schema > schemas_) throw std::invalid_argument("MCAP: channel " + topic + " of a schema not added");
   if (channels_ == UINT16_MAX) throw std::length_error("MCAP: too many channels");
   const std::uint16_t id = channels_++;

@@ -13,7 +13,8 @@
 namespace evldt {
 
 std::optional<SensorSize> sensor_of(std::uint32_t width, std::uint32_t height) {
-  if (width > static_cast<std::uint32_t>(kMaxSensorSide) || height > static_cast<std::uint32_t>(kMaxSensorSide)) return std::nullopt;
+  if (width > static_cast<std::uint32_t>(kMaxSensorSide) || height > static_cast<std::uint32_t>(kMaxSensorSide))
+    return std::nullopt;
   const SensorSize sensor{static_cast<int>(width), static_cast<int>(height)};
   return sensor.valid() ? std::optional(sensor) : std::nullopt;
 }
@@ -59,8 +60,9 @@ bool PacketEventReader::fill(EventBatch& out) {
       retire_decoder(out);  // a stream that changes encoding ends the old one
       decoder_ = make_packet_decoder(packet_.encoding, source_name_ + " " + packet_.location);
       if (!decoder_) {
-        throw FormatError(source_name_, 0, packet_.location + ": no decoder for the event encoding '" + packet_.encoding +
-                                               "' (evldt decodes evt2, evt3, libcaer, libcaer_cmp, mono)");
+        throw FormatError(source_name_, 0,
+                          packet_.location + ": no decoder for the event encoding '" + packet_.encoding +
+                              "' (evldt decodes evt2, evt3, libcaer, libcaer_cmp, mono)");
       }
       encoding_ = packet_.encoding;
     }

@@ -52,7 +52,8 @@ class MessageReader {
   /// A sequence's element count, refused when the elements cannot fit in what is left.
   std::uint32_t read_count(std::size_t min_element_bytes) {
     const auto count = read<std::uint32_t>();
-    if (count > (bytes_.size() - at_) / min_element_bytes) fail(std::to_string(count) + " elements do not fit in the message");
+    if (count > (bytes_.size() - at_) / min_element_bytes)
+      fail(std::to_string(count) + " elements do not fit in the message");
     return count;
   }
 
@@ -109,7 +110,9 @@ std::string_view trim(std::string_view text) {
   return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
 }
 
-bool is_header(std::string_view type) { return type == "Header" || type == "std_msgs/Header" || type == "std_msgs/msg/Header"; }
+bool is_header(std::string_view type) {
+  return type == "Header" || type == "std_msgs/Header" || type == "std_msgs/msg/Header";
+}
 
 /// Bytes of a primitive field; 0 for a type that is not one.
 std::size_t primitive_bytes(std::string_view type) {
@@ -141,7 +144,8 @@ std::vector<RosEventLayout::Field> parse_message_fields(std::string_view definit
   return fields;
 }
 
-std::optional<RosEventLayout> RosEventLayout::of(RosSerialization serialization, std::string_view type, std::string_view definition) {
+std::optional<RosEventLayout> RosEventLayout::of(RosSerialization serialization, std::string_view type,
+                                                 std::string_view definition) {
   RosEventLayout layout;
   layout.serialization_ = serialization;
   const bool ros1 = serialization == RosSerialization::Ros1;
@@ -215,15 +219,24 @@ RosEventMessage RosEventLayout::decode(std::span<const std::uint8_t> bytes, std:
     } else {
       std::uint64_t value = 0;
       switch (primitive_bytes(field.type)) {
-        case 1: value = reader.read<std::uint8_t>(); break;
-        case 2: value = reader.read<std::uint16_t>(); break;
-        case 4: value = reader.read<std::uint32_t>(); break;
-        default: value = reader.read<std::uint64_t>(); break;
+        case 1:
+          value = reader.read<std::uint8_t>();
+          break;
+        case 2:
+          value = reader.read<std::uint16_t>();
+          break;
+        case 4:
+          value = reader.read<std::uint32_t>();
+          break;
+        default:
+          value = reader.read<std::uint64_t>();
+          break;
       }
       if (field.name == "width") message.width = static_cast<std::uint32_t>(value);
       if (field.name == "height") message.height = static_cast<std::uint32_t>(value);
       if (field.name == "time_base") message.time_base = value;
-      if (field.name == "is_bigendian" && value != 0) throw std::runtime_error("big-endian event data is not supported");
+      if (field.name == "is_bigendian" && value != 0)
+        throw std::runtime_error("big-endian event data is not supported");
     }
   }
   return message;
@@ -251,8 +264,8 @@ RecordingImage decode_ros_image(RosSerialization serialization, std::span<const 
   image.step = reader.read<std::uint32_t>();
   image.data = reader.read_bytes();
   if (std::uint64_t{image.step} * image.height > image.data.size()) {
-    throw std::runtime_error("an image of " + std::to_string(image.height) + " rows of " + std::to_string(image.step) + " bytes holds only " +
-                             std::to_string(image.data.size()) + " bytes");
+    throw std::runtime_error("an image of " + std::to_string(image.height) + " rows of " + std::to_string(image.step) +
+                             " bytes holds only " + std::to_string(image.data.size()) + " bytes");
   }
   return image;
 }

@@ -19,7 +19,8 @@ namespace {
 class Rosbag1Topic {
  public:
   Rosbag1Topic(const std::filesystem::path& path, const std::string& wanted,
-               const std::function<bool(const rosbag::ConnectionInfo&)>& accepts, const std::string& kind, const std::string& expected)
+               const std::function<bool(const rosbag::ConnectionInfo&)>& accepts, const std::string& kind,
+               const std::string& expected)
       : path_(path.string()) {
     try {
       bag_.open(path_, rosbag::bagmode::Read);
@@ -28,14 +29,15 @@ class Rosbag1Topic {
       for (const rosbag::ConnectionInfo* connection : all.getConnections()) {
         listing += (listing.empty() ? "" : ", ") + connection->topic + " (" + connection->datatype + ")";
         if (!topic_.empty() || (wanted.empty() ? !accepts(*connection) : connection->topic != wanted)) continue;
-        if (!accepts(*connection)) throw std::runtime_error("topic " + wanted + " is of type " + connection->datatype + ", not " + expected);
+        if (!accepts(*connection))
+          throw std::runtime_error("topic " + wanted + " is of type " + connection->datatype + ", not " + expected);
         topic_ = connection->topic;
         type_ = connection->datatype;
         definition_ = connection->msg_def;
       }
       if (topic_.empty()) {
-        throw std::runtime_error((wanted.empty() ? "no topic of " + kind : "no topic " + wanted) + " (topics: " +
-                                 (listing.empty() ? "none" : listing) + ")");
+        throw std::runtime_error((wanted.empty() ? "no topic of " + kind : "no topic " + wanted) +
+                                 " (topics: " + (listing.empty() ? "none" : listing) + ")");
       }
       view_.emplace(bag_, rosbag::TopicQuery(topic_));
       total_ = view_->size();
@@ -64,7 +66,9 @@ class Rosbag1Topic {
   [[nodiscard]] const std::string& topic() const { return topic_; }
   [[nodiscard]] const std::string& type() const { return type_; }
   [[nodiscard]] const std::string& definition() const { return definition_; }
-  [[nodiscard]] double progress() const { return total_ == 0 ? 1.0 : static_cast<double>(read_) / static_cast<double>(total_); }
+  [[nodiscard]] double progress() const {
+    return total_ == 0 ? 1.0 : static_cast<double>(read_) / static_cast<double>(total_);
+  }
 
  private:
   std::string path_;
@@ -78,10 +82,13 @@ class Rosbag1Topic {
 class Rosbag1Source final : public PacketSource {
  public:
   Rosbag1Source(const std::filesystem::path& path, const std::string& topic)
-      : topic_(path, topic, [](const rosbag::ConnectionInfo& connection) {
-          // The layout from the definition the bag stores for the connection.
-          return RosEventLayout::of(RosSerialization::Ros1, connection.datatype, connection.msg_def).has_value();
-        }, "an event type", std::string(kKnownEventTypes)),
+      : topic_(
+            path, topic,
+            [](const rosbag::ConnectionInfo& connection) {
+              // The layout from the definition the bag stores for the connection.
+              return RosEventLayout::of(RosSerialization::Ros1, connection.datatype, connection.msg_def).has_value();
+            },
+            "an event type", std::string(kKnownEventTypes)),
         layout_(*RosEventLayout::of(RosSerialization::Ros1, topic_.type(), topic_.definition())) {}
 
   bool next(RecordingPacket& packet) override {
@@ -101,7 +108,9 @@ class Rosbag1Source final : public PacketSource {
 
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return std::nullopt; }  // in the messages
   [[nodiscard]] std::string camera() const override { return camera_; }
-  [[nodiscard]] std::string description() const override { return "ROS 1 bag, " + topic_.topic() + " (" + topic_.type() + ")"; }
+  [[nodiscard]] std::string description() const override {
+    return "ROS 1 bag, " + topic_.topic() + " (" + topic_.type() + ")";
+  }
   [[nodiscard]] double progress() const override { return topic_.progress(); }
   [[nodiscard]] std::uint64_t skipped_packets() const override { return 0; }  // other topics are not read
 
@@ -115,8 +124,9 @@ class Rosbag1Source final : public PacketSource {
 class Rosbag1ImageSource final : public ImageSource {
  public:
   Rosbag1ImageSource(const std::filesystem::path& path, const std::string& topic)
-      : topic_(path, topic, [](const rosbag::ConnectionInfo& connection) { return connection.datatype == kRos1ImageType; },
-               "type " + std::string(kRos1ImageType), std::string(kRos1ImageType)) {}
+      : topic_(
+            path, topic, [](const rosbag::ConnectionInfo& connection) { return connection.datatype == kRos1ImageType; },
+            "type " + std::string(kRos1ImageType), std::string(kRos1ImageType)) {}
 
   bool next(RecordingImage& image, std::string& location) override {
     location = topic_.path() + ", " + topic_.location();
@@ -131,7 +141,9 @@ class Rosbag1ImageSource final : public ImageSource {
     }
   }
 
-  [[nodiscard]] std::string description() const override { return "ROS 1 bag, " + topic_.topic() + " (" + topic_.type() + ")"; }
+  [[nodiscard]] std::string description() const override {
+    return "ROS 1 bag, " + topic_.topic() + " (" + topic_.type() + ")";
+  }
 
  private:
   Rosbag1Topic topic_;

@@ -40,8 +40,8 @@ std::string column_text(sqlite3_stmt* statement, int column) {
 class Rosbag2Topic {
  public:
   Rosbag2Topic(const std::filesystem::path& path, const std::string& wanted,
-               const std::function<bool(const std::string& type, const std::string& definition)>& accepts, const std::string& kind,
-               const std::string& expected)
+               const std::function<bool(const std::string& type, const std::string& definition)>& accepts,
+               const std::string& kind, const std::string& expected)
       : path_(path.string()) {
     if (sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
       const std::string reason = db_ ? sqlite3_errmsg(db_) : "out of memory";
@@ -52,7 +52,8 @@ class Rosbag2Topic {
       choose_topic(wanted, accepts, kind, expected);
       Statement count(db_, "SELECT COUNT(*) FROM messages WHERE topic_id = ?");
       sqlite3_bind_int64(count.get(), 1, topic_id_);
-      if (sqlite3_step(count.get()) == SQLITE_ROW) total_ = static_cast<std::uint64_t>(sqlite3_column_int64(count.get(), 0));
+      if (sqlite3_step(count.get()) == SQLITE_ROW)
+        total_ = static_cast<std::uint64_t>(sqlite3_column_int64(count.get(), 0));
       // In time order as rosbag2 plays them; the timestamp index makes this a stream, not a sort.
       messages_.emplace(db_, "SELECT id, data FROM messages WHERE topic_id = ? ORDER BY timestamp, id");
       sqlite3_bind_int64(messages_->get(), 1, topic_id_);
@@ -74,7 +75,8 @@ class Rosbag2Topic {
   bool next(std::span<const std::uint8_t>& message, std::string& location) {
     const int status = sqlite3_step(messages_->get());
     if (status == SQLITE_DONE) return false;
-    if (status != SQLITE_ROW) throw FormatError(path_, 0, std::string("cannot read the next message: ") + sqlite3_errmsg(db_));
+    if (status != SQLITE_ROW)
+      throw FormatError(path_, 0, std::string("cannot read the next message: ") + sqlite3_errmsg(db_));
     ++read_;
     location = "message id " + std::to_string(sqlite3_column_int64(messages_->get(), 0));
     const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(messages_->get(), 1));
@@ -85,15 +87,19 @@ class Rosbag2Topic {
   [[nodiscard]] const std::string& topic() const { return topic_; }
   [[nodiscard]] const std::string& type() const { return type_; }
   [[nodiscard]] const std::string& definition() const { return definition_; }
-  [[nodiscard]] double progress() const { return total_ == 0 ? 1.0 : static_cast<double>(read_) / static_cast<double>(total_); }
+  [[nodiscard]] double progress() const {
+    return total_ == 0 ? 1.0 : static_cast<double>(read_) / static_cast<double>(total_);
+  }
 
  private:
   /// The .msg definition of `type` where the bag keeps one (rosbag2 since Iron: message_definitions);
   /// empty otherwise.
   std::string message_definition(const std::string& type) const {
     sqlite3_stmt* statement = nullptr;
-    if (sqlite3_prepare_v2(db_, "SELECT encoded_message_definition FROM message_definitions WHERE topic_type = ? AND encoding = 'ros2msg'",
-                           -1, &statement, nullptr) != SQLITE_OK) {
+    if (sqlite3_prepare_v2(
+            db_,
+            "SELECT encoded_message_definition FROM message_definitions WHERE topic_type = ? AND encoding = 'ros2msg'",
+            -1, &statement, nullptr) != SQLITE_OK) {
       return {};  // an older bag: no such table
     }
     sqlite3_bind_text(statement, 1, type.c_str(), -1, SQLITE_TRANSIENT);
@@ -102,8 +108,9 @@ class Rosbag2Topic {
     return definition;
   }
 
-  void choose_topic(const std::string& wanted, const std::function<bool(const std::string&, const std::string&)>& accepts,
-                    const std::string& kind, const std::string& expected) {
+  void choose_topic(const std::string& wanted,
+                    const std::function<bool(const std::string&, const std::string&)>& accepts, const std::string& kind,
+                    const std::string& expected) {
     Statement topics(db_, "SELECT id, name, type FROM topics ORDER BY id");
     std::string listing;
     while (sqlite3_step(topics.get()) == SQLITE_ROW) {
@@ -122,8 +129,8 @@ class Rosbag2Topic {
       definition_ = std::move(definition);
     }
     if (topic_id_ < 0) {
-      throw std::runtime_error((wanted.empty() ? "no topic of " + kind : "no topic " + wanted) + " (topics: " +
-                               (listing.empty() ? "none" : listing) + ")");
+      throw std::runtime_error((wanted.empty() ? "no topic of " + kind : "no topic " + wanted) +
+                               " (topics: " + (listing.empty() ? "none" : listing) + ")");
     }
   }
 
@@ -138,9 +145,12 @@ class Rosbag2Topic {
 class Rosbag2Source final : public PacketSource {
  public:
   Rosbag2Source(const std::filesystem::path& path, const std::string& topic)
-      : topic_(path, topic, [](const std::string& type, const std::string& definition) {
-          return RosEventLayout::of(RosSerialization::Cdr, type, definition).has_value();
-        }, "an event type", std::string(kKnownEventTypes)),
+      : topic_(
+            path, topic,
+            [](const std::string& type, const std::string& definition) {
+              return RosEventLayout::of(RosSerialization::Cdr, type, definition).has_value();
+            },
+            "an event type", std::string(kKnownEventTypes)),
         layout_(*RosEventLayout::of(RosSerialization::Cdr, topic_.type(), topic_.definition())) {}
 
   bool next(RecordingPacket& packet) override {
@@ -158,7 +168,9 @@ class Rosbag2Source final : public PacketSource {
 
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return std::nullopt; }  // in the packets
   [[nodiscard]] std::string camera() const override { return camera_; }
-  [[nodiscard]] std::string description() const override { return "ROS 2 bag, " + topic_.topic() + " (" + topic_.type() + ")"; }
+  [[nodiscard]] std::string description() const override {
+    return "ROS 2 bag, " + topic_.topic() + " (" + topic_.type() + ")";
+  }
   [[nodiscard]] double progress() const override { return topic_.progress(); }
   [[nodiscard]] std::uint64_t skipped_packets() const override { return 0; }  // other topics are not read
 
@@ -172,8 +184,9 @@ class Rosbag2Source final : public PacketSource {
 class Rosbag2ImageSource final : public ImageSource {
  public:
   Rosbag2ImageSource(const std::filesystem::path& path, const std::string& topic)
-      : topic_(path, topic, [](const std::string& type, const std::string&) { return type == kRos2ImageType; },
-               "type " + std::string(kRos2ImageType), std::string(kRos2ImageType)) {}
+      : topic_(
+            path, topic, [](const std::string& type, const std::string&) { return type == kRos2ImageType; },
+            "type " + std::string(kRos2ImageType), std::string(kRos2ImageType)) {}
 
   bool next(RecordingImage& image, std::string& location) override {
     std::span<const std::uint8_t> message;
@@ -188,7 +201,9 @@ class Rosbag2ImageSource final : public ImageSource {
     return true;
   }
 
-  [[nodiscard]] std::string description() const override { return "ROS 2 bag, " + topic_.topic() + " (" + topic_.type() + ")"; }
+  [[nodiscard]] std::string description() const override {
+    return "ROS 2 bag, " + topic_.topic() + " (" + topic_.type() + ")";
+  }
 
  private:
   Rosbag2Topic topic_;

@@ -9,8 +9,7 @@
 namespace evldt {
 
 EvaluationAccumulator::EvaluationAccumulator(std::vector<double> tolerance_fractions)
-    : tolerance_fractions_(std::move(tolerance_fractions)),
-      totals_(tolerance_fractions_.size()) {
+    : tolerance_fractions_(std::move(tolerance_fractions)), totals_(tolerance_fractions_.size()) {
   if (tolerance_fractions_.empty()) throw std::invalid_argument("an evaluation needs at least one tolerance");
 }
 

@@ -18,11 +18,12 @@ constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 }  // namespace
 
 std::vector<std::size_t> max_weight_matching(std::size_t rows, std::size_t columns,
-                                              std::span<const WeightedPair> pairs) {
+                                             std::span<const WeightedPair> pairs) {
   for (const WeightedPair& p : pairs) {
     if (p.row >= rows || p.column >= columns) {
       throw std::invalid_argument("pair (" + std::to_string(p.row) + ", " + std::to_string(p.column) +
-                                  ") is outside a " + std::to_string(rows) + " x " + std::to_string(columns) + " graph");
+                                  ") is outside a " + std::to_string(rows) + " x " + std::to_string(columns) +
+                                  " graph");
     }
     if (!std::isfinite(p.weight) || p.weight <= 0) {
       throw std::invalid_argument("pair weights must be finite and > 0, got " + std::to_string(p.weight));

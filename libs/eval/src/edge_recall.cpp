@@ -18,16 +18,20 @@ namespace {
 
 float measure_of(const EdgeStep& step, EdgeMeasure measure) {
   switch (measure) {
-    case EdgeMeasure::NormalSpeed: return step.normal_speed_px_s;
-    case EdgeMeasure::Length: return step.length_px;
-    case EdgeMeasure::ParallelGap: return step.parallel_gap_px;
+    case EdgeMeasure::NormalSpeed:
+      return step.normal_speed_px_s;
+    case EdgeMeasure::Length:
+      return step.length_px;
+    case EdgeMeasure::ParallelGap:
+      return step.parallel_gap_px;
   }
   return std::numeric_limits<float>::quiet_NaN();
 }
 
 /// Distance to the nearest piece of another line that is parallel to `piece` within the limit and
 /// overlaps it along its length.
-float parallel_gap(const Segment& piece, std::size_t self, std::span<const Segment> truth, std::span<const std::uint64_t> ids) {
+float parallel_gap(const Segment& piece, std::size_t self, std::span<const Segment> truth,
+                   std::span<const std::uint64_t> ids) {
   const float length = piece.length();
   const Point2 unit = (piece.q1 - piece.q0) / length;
   const Point2 normal(-unit.y(), unit.x());
@@ -52,7 +56,10 @@ float parallel_gap(const Segment& piece, std::size_t self, std::span<const Segme
 void EdgeRecall::add_step(Timestamp t, std::span<const Segment> truth, std::span<const std::uint64_t> ids,
                           std::span<const Segment> predicted, std::span<const std::uint8_t> matched_map) {
   if (picture_at_us_ && !picture_ && t >= *picture_at_us_) {
-    picture_ = Picture{t, {truth.begin(), truth.end()}, {predicted.begin(), predicted.end()}, {matched_map.begin(), matched_map.end()}};
+    picture_ = Picture{t,
+                       {truth.begin(), truth.end()},
+                       {predicted.begin(), predicted.end()},
+                       {matched_map.begin(), matched_map.end()}};
   }
   std::unordered_map<std::uint64_t, Seen> current;
   const auto width = static_cast<std::uint32_t>(sensor_.width);
@@ -65,11 +72,14 @@ void EdgeRecall::add_step(Timestamp t, std::span<const Segment> truth, std::span
     const Point2 normal = Point2(-(piece.q1 - piece.q0).y(), (piece.q1 - piece.q0).x()) / length;
     if (const auto seen = previous_.find(ids[i]); seen != previous_.end() && t > seen->second.t_us) {
       const Point2 before = 0.5f * (seen->second.first_piece.q0 + seen->second.first_piece.q1);
-      step.normal_speed_px_s = std::abs((before - piece.q0).dot(normal)) / (static_cast<float>(t - seen->second.t_us) * 1e-6f);
+      step.normal_speed_px_s =
+          std::abs((before - piece.q0).dot(normal)) / (static_cast<float>(t - seen->second.t_us) * 1e-6f);
     }
     current.try_emplace(ids[i], Seen{t, piece});
     pixels_.clear();
-    for_each_segment_sample(piece, sensor_, [&](int x, int y) { pixels_.push_back(static_cast<std::uint32_t>(y) * width + static_cast<std::uint32_t>(x)); });
+    for_each_segment_sample(piece, sensor_, [&](int x, int y) {
+      pixels_.push_back(static_cast<std::uint32_t>(y) * width + static_cast<std::uint32_t>(x));
+    });
     std::sort(pixels_.begin(), pixels_.end());
     pixels_.erase(std::unique(pixels_.begin(), pixels_.end()), pixels_.end());
     step.pixels = static_cast<std::uint32_t>(pixels_.size());
@@ -79,7 +89,8 @@ void EdgeRecall::add_step(Timestamp t, std::span<const Segment> truth, std::span
   previous_ = std::move(current);
 }
 
-std::vector<EdgeRecallBin> bin_edge_recall(std::span<const EdgeStep> steps, EdgeMeasure measure, std::span<const double> edges) {
+std::vector<EdgeRecallBin> bin_edge_recall(std::span<const EdgeStep> steps, EdgeMeasure measure,
+                                           std::span<const double> edges) {
   std::vector<EdgeRecallBin> bins;
   for (std::size_t b = 0; b + 1 < edges.size(); ++b) bins.push_back({edges[b], edges[b + 1], 0, 0});
   for (const EdgeStep& step : steps) {
@@ -115,19 +126,25 @@ std::string edge_recall_tables(std::span<const EdgeStep> steps) {
     out += fmt::format("{:<28} {:>14} {:>8}\n", table.title, "share of gt px", "recall");
     for (const EdgeRecallBin& bin : bins) {
       if (bin.pixels == 0) continue;
-      const std::string range = std::isinf(bin.hi) ? fmt::format("{:g} and more", bin.lo) : fmt::format("{:g} - {:g}", bin.lo, bin.hi);
-      out += fmt::format("  {:<26} {:>14.3f} {:>8.3f}\n", range, static_cast<double>(bin.pixels) / static_cast<double>(all),
+      const std::string range =
+          std::isinf(bin.hi) ? fmt::format("{:g} and more", bin.lo) : fmt::format("{:g} - {:g}", bin.lo, bin.hi);
+      out += fmt::format("  {:<26} {:>14.3f} {:>8.3f}\n", range,
+                         static_cast<double>(bin.pixels) / static_cast<double>(all),
                          static_cast<double>(bin.matched) / static_cast<double>(bin.pixels));
     }
   }
   return out;
 }
 
-std::string edge_recall_csv_header() { return "run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched\n"; }
+std::string edge_recall_csv_header() {
+  return "run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched\n";
+}
 
 std::string edge_recall_csv_rows(const std::string& run, std::span<const EdgeStep> steps) {
   std::string out;
-  const auto number = [](float v) { return std::isfinite(v) ? fmt::format("{:.3f}", v) : std::string(std::isnan(v) ? "" : "inf"); };
+  const auto number = [](float v) {
+    return std::isfinite(v) ? fmt::format("{:.3f}", v) : std::string(std::isnan(v) ? "" : "inf");
+  };
   for (const EdgeStep& s : steps) {
     out += fmt::format("{},{},{},{:.3f},{},{},{},{}\n", run, s.t_us, s.id, s.length_px, number(s.normal_speed_px_s),
                        number(s.parallel_gap_px), s.pixels, s.matched);
@@ -135,9 +152,11 @@ std::string edge_recall_csv_rows(const std::string& run, std::span<const EdgeSte
   return out;
 }
 
-void write_edge_recall_png(const std::filesystem::path& path, const EdgeRecall& recall, const std::string& title, int scale) {
+void write_edge_recall_png(const std::filesystem::path& path, const EdgeRecall& recall, const std::string& title,
+                           int scale) {
   const auto& picture = recall.picture();
-  if (!picture) throw std::runtime_error("no step to draw for " + path.string() + ": the run ended before the picture's time");
+  if (!picture)
+    throw std::runtime_error("no step to draw for " + path.string() + ": the run ended before the picture's time");
   const SensorSize sensor = recall.sensor();
   constexpr int kBanner = 24;
   cv::Mat image(sensor.height * scale + kBanner, sensor.width * scale, CV_8UC3, cv::Scalar(255, 255, 255));
@@ -154,10 +173,12 @@ void write_edge_recall_png(const std::filesystem::path& path, const EdgeRecall& 
                      static_cast<int>(std::lround(p.y() * static_cast<float>(scale))) + kBanner);
   };
   for (const Segment& s : picture->predicted) {
-    if (s.q0.allFinite() && s.q1.allFinite()) cv::line(image, at(s.q0), at(s.q1), cv::Scalar(200, 90, 20), 1, cv::LINE_AA);
+    if (s.q0.allFinite() && s.q1.allFinite())
+      cv::line(image, at(s.q0), at(s.q1), cv::Scalar(200, 90, 20), 1, cv::LINE_AA);
   }
-  cv::putText(image, fmt::format("{} at {:.3f} s: true edges found (green) / missed (red), predicted (blue)", title,
-                                 static_cast<double>(picture->t_us) * 1e-6),
+  cv::putText(image,
+              fmt::format("{} at {:.3f} s: true edges found (green) / missed (red), predicted (blue)", title,
+                          static_cast<double>(picture->t_us) * 1e-6),
               cv::Point(4, 17), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   if (!media::write_image(path.string(), image)) throw std::runtime_error("could not write " + path.string());
 }

@@ -68,7 +68,10 @@ void write_evaluation_json(JsonWriter& json, const EvaluationReport& r) {
     json.key("precision").value(p.precision).key("recall").value(p.recall).key("f").value(p.f).end_object();
   }
   json.end_array();
-  json.key("mean_segments_per_step").value(r.mean_predicted).key("mean_gt_segments_per_step").value(r.mean_ground_truth);
+  json.key("mean_segments_per_step")
+      .value(r.mean_predicted)
+      .key("mean_gt_segments_per_step")
+      .value(r.mean_ground_truth);
   json.key("lifetime").begin_object().key("ids").value(r.lifetime.count).key("mean_ms").value(r.lifetime.mean_ms);
   json.key("std_ms").value(r.lifetime.std_ms).key("max_ms").value(r.lifetime.max_ms).end_object();
   const TrackingSummary& t = r.tracking;
@@ -81,7 +84,12 @@ void write_evaluation_json(JsonWriter& json, const EvaluationReport& r) {
   json.key("velocity_pairs").value(t.velocity_pairs).key("vel_err_med").value(t.velocity_error_median);
   json.key("vel_rel_med").value(t.velocity_relative_median);
   const IdSwitchCauses& c = t.switch_causes;
-  json.key("id_switch_causes").begin_object().key("to_other_edge").value(c.to_other_edge).key("off_edge").value(c.off_edge);
+  json.key("id_switch_causes")
+      .begin_object()
+      .key("to_other_edge")
+      .value(c.to_other_edge)
+      .key("off_edge")
+      .value(c.off_edge);
   json.key("returned").value(c.returned).key("redetected").value(c.redetected).key("taken_over").value(c.taken_over);
   json.key("after_gap").value(c.after_gap).end_object();
   json.end_object();

@@ -10,8 +10,8 @@ namespace evldt {
 
 std::vector<Segment> lsd_segments(const cv::Mat& grey, const LsdParams& params) {
   const cv::Ptr<cv::LineSegmentDetector> lsd =
-      cv::createLineSegmentDetector(cv::LSD_REFINE_STD, params.scale, params.sigma_scale, params.quant, params.angle_tolerance_deg,
-                                    params.log_eps, params.density_threshold);
+      cv::createLineSegmentDetector(cv::LSD_REFINE_STD, params.scale, params.sigma_scale, params.quant,
+                                    params.angle_tolerance_deg, params.log_eps, params.density_threshold);
   std::vector<cv::Vec4f> found;
   lsd->detect(grey, found);
   std::vector<Segment> segments;
@@ -68,7 +68,8 @@ std::vector<std::vector<std::uint8_t>> event_supported_pieces(const GroundTruthS
         continue;
       }
       if (batch.t[next] > until) return;
-      if (batch.x[next] < width && batch.y[next] < height) latest[batch.y[next] * width + batch.x[next]] = batch.t[next];
+      if (batch.x[next] < width && batch.y[next] < height)
+        latest[batch.y[next] * width + batch.x[next]] = batch.t[next];
       ++next;
     }
   };

@@ -96,7 +96,8 @@ void rasterise(std::span<const Segment> segments, SensorSize sensor, std::vector
   map.assign(pixel_count(sensor), 0);
   const auto width = static_cast<std::size_t>(sensor.width);
   for (const Segment& s : segments) {
-    for_each_segment_sample(s, sensor, [&](int x, int y) { map[static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)] = 1; });
+    for_each_segment_sample(
+        s, sensor, [&](int x, int y) { map[static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x)] = 1; });
   }
 }
 
@@ -148,11 +149,13 @@ void HeatmapMatcher::matched_ground_truth(std::vector<std::uint8_t>& map) const 
   map.assign(pixel_count(sensor_), 0);
   for (std::size_t i = 0; i < bucketed_.size(); ++i) {
     if (mate_of_ground_truth_[i] == kNone) continue;
-    map[static_cast<std::size_t>(bucketed_[i].y) * static_cast<std::size_t>(sensor_.width) + static_cast<std::size_t>(bucketed_[i].x)] = 1;
+    map[static_cast<std::size_t>(bucketed_[i].y) * static_cast<std::size_t>(sensor_.width) +
+        static_cast<std::size_t>(bucketed_[i].x)] = 1;
   }
 }
 
-void HeatmapMatcher::matched_predicted(std::span<const std::uint8_t> predicted_map, std::vector<std::uint8_t>& map) const {
+void HeatmapMatcher::matched_predicted(std::span<const std::uint8_t> predicted_map,
+                                       std::vector<std::uint8_t>& map) const {
   check_map_size(predicted_map, sensor_, "predicted");
   map.assign(pixel_count(sensor_), 0);
   // The predicted pixels were numbered in the order for_each_line_pixel visits them.

@@ -17,17 +17,20 @@ const cv::Scalar kUnseenTruthColour(200, 80, 220);  // LSD's lines without event
 
 /// The rows of the step held at `t`: the latest step at or before it, if within `hold_us`.
 std::span<const SegmentRow> held_at(std::span<const SegmentRow> sorted, Timestamp t, Timestamp hold_us) {
-  const auto after = std::upper_bound(sorted.begin(), sorted.end(), t, [](Timestamp v, const SegmentRow& r) { return v < r.t_us; });
+  const auto after =
+      std::upper_bound(sorted.begin(), sorted.end(), t, [](Timestamp v, const SegmentRow& r) { return v < r.t_us; });
   if (after == sorted.begin()) return {};
   const Timestamp step = std::prev(after)->t_us;
   if (t - step > hold_us) return {};
-  const auto first = std::lower_bound(sorted.begin(), after, step, [](const SegmentRow& r, Timestamp v) { return r.t_us < v; });
+  const auto first =
+      std::lower_bound(sorted.begin(), after, step, [](const SegmentRow& r, Timestamp v) { return r.t_us < v; });
   return {first, after};
 }
 
 std::vector<SegmentRow> by_time(std::span<const SegmentRow> rows) {
   std::vector<SegmentRow> sorted(rows.begin(), rows.end());
-  std::stable_sort(sorted.begin(), sorted.end(), [](const SegmentRow& a, const SegmentRow& b) { return a.t_us < b.t_us; });
+  std::stable_sort(sorted.begin(), sorted.end(),
+                   [](const SegmentRow& a, const SegmentRow& b) { return a.t_us < b.t_us; });
   return sorted;
 }
 
@@ -42,8 +45,8 @@ void draw(cv::Mat& canvas, const Segment& s, int scale, const cv::Scalar& colour
 }  // namespace
 
 std::size_t write_overlays(const std::filesystem::path& dir, FrameReader& frames, const GroundTruthSteps& truth,
-                           const OverlayStream& segments, const OverlayStream& whole_lines, const VisibilitySplit* visibility,
-                           int scale) {
+                           const OverlayStream& segments, const OverlayStream& whole_lines,
+                           const VisibilitySplit* visibility, int scale) {
   std::filesystem::create_directories(dir);
   const std::vector<SegmentRow> segment_rows = by_time(segments.rows), whole_rows = by_time(whole_lines.rows);
   std::vector<Segment> truth_segments, seen, unseen;
@@ -64,10 +67,12 @@ std::size_t write_overlays(const std::filesystem::path& dir, FrameReader& frames
       truth_segments = seen;
     }
     for (const Segment& s : truth_segments) draw(canvas, s, scale, kTruthColour, 2);
-    for (const SegmentRow& row : held_at(whole_rows, frame->t_us, whole_lines.hold_us)) draw(canvas, row.segment, scale, kWholeLineColour, 3);
-    for (const SegmentRow& row : held_at(segment_rows, frame->t_us, segments.hold_us)) draw(canvas, row.segment, scale, kSegmentColour, 1);
-    const std::string caption = "t " + std::to_string(frame->t_us) + " us   LSD green" + (visibility ? " (no events: purple)" : "") +
-                                ", segments red, whole lines blue";
+    for (const SegmentRow& row : held_at(whole_rows, frame->t_us, whole_lines.hold_us))
+      draw(canvas, row.segment, scale, kWholeLineColour, 3);
+    for (const SegmentRow& row : held_at(segment_rows, frame->t_us, segments.hold_us))
+      draw(canvas, row.segment, scale, kSegmentColour, 1);
+    const std::string caption = "t " + std::to_string(frame->t_us) + " us   LSD green" +
+                                (visibility ? " (no events: purple)" : "") + ", segments red, whole lines blue";
     cv::putText(canvas, caption, {6, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
     cv::putText(canvas, caption, {6, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
     char name[32];

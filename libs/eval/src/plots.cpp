@@ -224,11 +224,11 @@ void write_id_timeline_png(const std::filesystem::path& path, std::span<const Gr
     if (!line.owners.empty()) shown.push_back(&line);
   }
   if (shown.size() > kTimelineMaxLines) {
-    std::stable_sort(shown.begin(), shown.end(), [](const auto* a, const auto* b) { return a->visible_steps > b->visible_steps; });
+    std::stable_sort(shown.begin(), shown.end(),
+                     [](const auto* a, const auto* b) { return a->visible_steps > b->visible_steps; });
     shown.resize(kTimelineMaxLines);
-    std::stable_sort(shown.begin(), shown.end(), [](const auto* a, const auto* b) {
-      return a->owners.front().t_us < b->owners.front().t_us;
-    });
+    std::stable_sort(shown.begin(), shown.end(),
+                     [](const auto* a, const auto* b) { return a->owners.front().t_us < b->owners.front().t_us; });
   }
   cv::Mat image = blank_chart(title);
   const cv::Rect area(kMarginLeft, kMarginTop, kPlotWidth - kMarginLeft - kMarginRight,
@@ -295,8 +295,8 @@ void write_id_timeline_png(const std::filesystem::path& path, std::span<const Gr
       has_representative = true;
     }
     if (static_cast<int>(row) % label_every == 0) {
-      put_text(image, formatted("line %.0f", static_cast<double>(line.gt_id)), area.x - 6,
-               (top + bottom) / 2 + 4, kSmallText * 0.9, kBlack, Align::Right);
+      put_text(image, formatted("line %.0f", static_cast<double>(line.gt_id)), area.x - 6, (top + bottom) / 2 + 4,
+               kSmallText * 0.9, kBlack, Align::Right);
     }
   }
   cv::rectangle(image, area, kBlack, 1);

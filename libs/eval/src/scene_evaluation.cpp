@@ -137,7 +137,8 @@ void StreamEvaluator::score_steps_before(Timestamp until) {
       } else {
         normal_velocities_at(next_step_, 0.0f, speed_at_q0_);
         normal_velocities_at(next_step_, 1.0f, speed_at_q1_);
-        split_by_normal_speed(truth_, speed_at_q0_, speed_at_q1_, visible_rule_.min_normal_speed, visible_truth_, hidden_truth_);
+        split_by_normal_speed(truth_, speed_at_q0_, speed_at_q1_, visible_rule_.min_normal_speed, visible_truth_,
+                              hidden_truth_);
       }
       visible_matcher_->match(predicted, visible_truth_, hidden_truth_, matchers_, visible_counts_);
       visible_accuracy_->add_step(visible_counts_, predicted.size(), visible_truth_.size());
@@ -176,7 +177,8 @@ void StreamEvaluator::normal_velocities_at(std::size_t index, float along, std::
     Timestamp t_from = times[before], t_to = times[after];
     if (!std::isfinite(from)) from = 0, t_from = times[index];
     if (!std::isfinite(to)) to = 0, t_to = times[index];
-    if (t_to > t_from) velocities[piece] = static_cast<float>((to - from) / (static_cast<double>(t_to - t_from) * 1e-6));
+    if (t_to > t_from)
+      velocities[piece] = static_cast<float>((to - from) / (static_cast<double>(t_to - t_from) * 1e-6));
   }
 }
 
@@ -214,8 +216,8 @@ std::vector<StreamEvaluator::Second> StreamEvaluator::per_second() const {
   return seconds;
 }
 
-void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t> ids, std::span<const Segment> predicted,
-                                     std::span<const float> normal_velocities) {
+void StreamEvaluator::add_prediction(Timestamp t, std::span<const std::uint64_t> ids,
+                                     std::span<const Segment> predicted, std::span<const float> normal_velocities) {
   if (finished_) throw std::logic_error("prediction added after finish()");
   if (ids.size() != predicted.size()) throw std::invalid_argument("a predicted step needs one id per segment");
   if (!normal_velocities.empty() && normal_velocities.size() != predicted.size()) {
@@ -245,7 +247,8 @@ void StreamEvaluator::finish() {
   coverage_.predicted_steps_scored += held_scored_ ? 1 : 0;
 }
 
-Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_period_us, std::span<const Timestamp> truth_times) {
+Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_period_us,
+                             std::span<const Timestamp> truth_times) {
   std::vector<Timestamp> times;
   for (const SegmentRow& row : rows) times.push_back(row.t_us);
   std::sort(times.begin(), times.end());
@@ -277,7 +280,8 @@ StreamEvaluator evaluate_segment_rows(std::vector<SegmentRow> rows, GroundTruthS
       velocities.push_back(rows[i].normal_velocity);
       any_velocity = any_velocity || std::isfinite(rows[i].normal_velocity);
     }
-    evaluator.add_prediction(t, ids, predicted, any_velocity ? std::span<const float>(velocities) : std::span<const float>());
+    evaluator.add_prediction(t, ids, predicted,
+                             any_velocity ? std::span<const float>(velocities) : std::span<const float>());
   }
   evaluator.finish();
   return evaluator;
@@ -342,7 +346,8 @@ SceneRunResult evaluate_scene(const Scene& scene, const SimulatorConfig& sim, co
     if (thin > 1 && !batch.empty()) {
       // As the receiver decodes a thinned batch: every thin-th event, ending with the last.
       thinned.clear();
-      for (std::size_t i = (batch.size() - 1) % static_cast<std::size_t>(thin); i < batch.size(); i += static_cast<std::size_t>(thin)) {
+      for (std::size_t i = (batch.size() - 1) % static_cast<std::size_t>(thin); i < batch.size();
+           i += static_cast<std::size_t>(thin)) {
         thinned.push_back(batch[i]);
       }
       pipeline.process(thinned, RealtimeEngine::stored_copies(thin));

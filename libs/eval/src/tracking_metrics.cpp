@@ -45,7 +45,8 @@ double ratio(double numerator, double denominator) {
 TrackingEvaluator::TrackingEvaluator(SensorSize sensor, double tolerance_px, double min_overlap)
     : sensor_(sensor), tolerance_px_(tolerance_px), min_overlap_(min_overlap) {
   if (!sensor.valid()) {
-    throw std::invalid_argument("invalid sensor size " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height));
+    throw std::invalid_argument("invalid sensor size " + std::to_string(sensor.width) + "x" +
+                                std::to_string(sensor.height));
   }
   if (!std::isfinite(tolerance_px) || tolerance_px < 0) {
     throw std::invalid_argument("tracking tolerance must be finite and >= 0, got " + std::to_string(tolerance_px));
@@ -112,7 +113,6 @@ double TrackingEvaluator::measure_overlaps(const Segment& whole_segment, std::sp
   return length;
 }
 
-
 void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> predicted_ids,
                                  std::span<const Segment> predicted, std::span<const std::uint64_t> truth_ids,
                                  std::span<const Segment> truth, std::span<const float> predicted_velocities,
@@ -174,7 +174,8 @@ void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> pre
         const double sign = unit_normal(predicted[i]).dot(unit_normal(truth[piece])) < 0 ? -1.0 : 1.0;
         const double error = std::abs(sign * predicted_velocities[i] - truth_velocity);
         velocity_errors_.push_back(error);
-        if (std::abs(truth_velocity) >= kMinRelativeSpeed) relative_velocity_errors_.push_back(error / std::abs(truth_velocity));
+        if (std::abs(truth_velocity) >= kMinRelativeSpeed)
+          relative_velocity_errors_.push_back(error / std::abs(truth_velocity));
       }
     }
     matches_.push_back({line, predicted_ids[i], overlap_by_line_[best]});
@@ -208,7 +209,8 @@ void TrackingEvaluator::add_step(Timestamp t, std::span<const std::uint64_t> pre
     }
     if (previous.matched && representative != previous.id) {
       ++track.id_switches;
-      switches_.push_back({line, step, previous.id, representative, !track.owners.empty() && !track.owners.back().matched});
+      switches_.push_back(
+          {line, step, previous.id, representative, !track.owners.empty() && !track.owners.back().matched});
     }
     track.distinct_ids = ids_of_line_[line].size();
     track.owners.push_back({t, true, representative});

@@ -60,7 +60,8 @@ void VisibleOnlyMatcher::match(std::span<const Segment> predicted, std::span<con
   if (hidden_pixels_ > 0) {
     // Distances between pixel centres to the nearest hidden true pixel (exact Euclidean).
     cv::Mat background(sensor_.height, sensor_.width, CV_8U);
-    for (std::size_t p = 0; p < hidden_map_.size(); ++p) background.data[p] = hidden_map_[p] != 0 && visible_map_[p] == 0 ? 0 : 255;
+    for (std::size_t p = 0; p < hidden_map_.size(); ++p)
+      background.data[p] = hidden_map_[p] != 0 && visible_map_[p] == 0 ? 0 : 255;
     cv::distanceTransform(background, to_hidden_, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
   }
   for (std::size_t i = 0; i < matchers.size(); ++i) {

@@ -17,7 +17,8 @@ float distance_to_segment(const Point2& p, const Segment& s) {
 
 }  // namespace
 
-WholeLineSupport::WholeLineSupport(float distance_px, float weak_below) : distance_px_(distance_px), weak_below_(weak_below) {
+WholeLineSupport::WholeLineSupport(float distance_px, float weak_below)
+    : distance_px_(distance_px), weak_below_(weak_below) {
   if (!(distance_px >= 0) || !(weak_below >= 0 && weak_below <= 1)) {
     throw std::invalid_argument("support distance must be >= 0 and the weak share in 0..1");
   }

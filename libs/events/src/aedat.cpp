@@ -30,8 +30,8 @@ struct KnownChip {
 };
 // Most specific first: "DAVIS128" before "128", "DAVIS346" before "DAVIS".
 constexpr KnownChip kKnownChips[] = {
-    {"DAVIS128", {128, 128}, false}, {"DVS128", {128, 128}, true},   {"346", {346, 260}, false},
-    {"240", {240, 180}, false},      {"640", {640, 480}, false},     {"208", {208, 192}, false},
+    {"DAVIS128", {128, 128}, false}, {"DVS128", {128, 128}, true}, {"346", {346, 260}, false},
+    {"240", {240, 180}, false},      {"640", {640, 480}, false},   {"208", {208, 192}, false},
 };
 
 std::string uppercase(std::string text) {
@@ -198,7 +198,7 @@ class Aedat31Decoder final : public EventDecoder {
   std::uint64_t remaining_ = 0;  // bytes of the current packet's events
   bool polarity_packet_ = false;
   std::int32_t overflow_ = 0;
-  std::uint64_t offset_ = 0;        // of the next byte
+  std::uint64_t offset_ = 0;  // of the next byte
   std::uint64_t packet_start_ = 0;
   WordSplitter<kPolarityEventBytes> events_;
   DecodeCounts counts_;
@@ -215,12 +215,15 @@ class Aedat2Decoder final : public EventDecoder {
       read_header();
       records_.set_offset(header_.size());
     }
-    records_.feed(chunk, [&](const std::uint8_t* record, std::uint64_t) { decode_record(load_be32(record), load_be32(record + 4), out); });
+    records_.feed(chunk, [&](const std::uint8_t* record, std::uint64_t) {
+      decode_record(load_be32(record), load_be32(record + 4), out);
+    });
   }
 
   void finish(EventBatch&) override {
     header_.finish(source_);
-    if (records_.carried() > 0) throw FormatError(source_, records_.offset(), "file ends inside an 8-byte AEDAT 2.0 event");
+    if (records_.carried() > 0)
+      throw FormatError(source_, records_.offset(), "file ends inside an 8-byte AEDAT 2.0 event");
   }
 
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return sensor_; }
@@ -229,7 +232,8 @@ class Aedat2Decoder final : public EventDecoder {
  private:
   void read_header() {
     const auto version = header_.lines().empty() ? std::string() : header_.lines().front();
-    if (!version.starts_with("#!AER-DAT2")) throw FormatError(source_, 0, "not an AEDAT 2.0 file (no #!AER-DAT2.0 line)");
+    if (!version.starts_with("#!AER-DAT2"))
+      throw FormatError(source_, 0, "not an AEDAT 2.0 file (no #!AER-DAT2.0 line)");
     const auto chip_name = header_value(header_, "AEChip:");
     const KnownChip* chip = chip_name ? known_chip(*chip_name) : &kKnownChips[1];  // no chip line: a DVS128
     if (!chip) throw FormatError(source_, 0, "unknown chip '" + *chip_name + "': its event addresses cannot be read");
@@ -247,7 +251,8 @@ class Aedat2Decoder final : public EventDecoder {
         ++counts_.skipped_words;  // special or external events
         return;
       }
-      out.push_back(t, static_cast<std::uint16_t>(127 - ((address >> 1) & 0x7F)), static_cast<std::uint16_t>(127 - ((address >> 8) & 0x7F)),
+      out.push_back(t, static_cast<std::uint16_t>(127 - ((address >> 1) & 0x7F)),
+                    static_cast<std::uint16_t>(127 - ((address >> 8) & 0x7F)),
                     (address & 1u) == 0 ? std::int8_t{1} : std::int8_t{-1});
       return;
     }

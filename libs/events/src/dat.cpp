@@ -42,7 +42,8 @@ class DatDecoder final : public EventDecoder {
   void finish(EventBatch& /*out*/) override {
     header_.finish(source_);
     if (type_and_size_read_ < 2) {
-      throw FormatError(source_, header_.size() + type_and_size_read_, "file ends before the event type and size bytes");
+      throw FormatError(source_, header_.size() + type_and_size_read_,
+                        "file ends before the event type and size bytes");
     }
     if (records_.carried() > 0) {
       throw FormatError(source_, records_.offset(),
@@ -72,7 +73,8 @@ class DatDecoder final : public EventDecoder {
     if (last_time_ >= time + std::uint64_t{kTimeHalfRange}) wraps_ += 1;
     last_time_ = time;
     out.push_back(wraps_ * kTimeRange + time, static_cast<std::uint16_t>(data & 0x3FFF),
-                  static_cast<std::uint16_t>((data >> 14) & 0x3FFF), (data >> 28) != 0 ? std::int8_t{1} : std::int8_t{-1});
+                  static_cast<std::uint16_t>((data >> 14) & 0x3FFF),
+                  (data >> 28) != 0 ? std::int8_t{1} : std::int8_t{-1});
   }
 
   std::string source_;
@@ -88,8 +90,8 @@ class DatEncoder final : public EventEncoder {
   explicit DatEncoder(SensorSize sensor) : sensor_(sensor) {}
 
   void write_header(std::vector<std::uint8_t>& out) const override {
-    const std::string header = "% Data file containing CD events\n% Version 2\n% Width " + std::to_string(sensor_.width) +
-                               "\n% Height " + std::to_string(sensor_.height) + "\n";
+    const std::string header = "% Data file containing CD events\n% Version 2\n% Width " +
+                               std::to_string(sensor_.width) + "\n% Height " + std::to_string(sensor_.height) + "\n";
     out.insert(out.end(), header.begin(), header.end());
     out.push_back(kCdEventType);
     out.push_back(kRecordBytes);

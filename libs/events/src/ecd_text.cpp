@@ -54,7 +54,8 @@ bool is_digit(char c) { return c >= '0' && c <= '9'; }
 /// The common line, "SECONDS[.FRACTION] X Y P" with single blanks or runs of them, read in one pass
 /// (a third of the time of the general path, which reads whole files of these): false, with nothing
 /// read, for any other line, which the general path then reads or reports.
-bool parse_plain_line(const char* s, const char* end, Timestamp& t, std::uint16_t& x, std::uint16_t& y, std::int8_t& p) {
+bool parse_plain_line(const char* s, const char* end, Timestamp& t, std::uint16_t& x, std::uint16_t& y,
+                      std::int8_t& p) {
   const char* const whole_begin = s;
   const char* const whole_limit = s + std::min<std::ptrdiff_t>(end - s, static_cast<std::ptrdiff_t>(kMaxSecondsDigits));
   Timestamp us = 0;
@@ -192,8 +193,8 @@ class EcdTextDecoder final : public EventDecoder {
   void check_line_length(std::size_t length, std::uint64_t offset) const {
     if (length > kMaxLineBytes) {
       throw FormatError(source_, offset,
-                        "line " + std::to_string(line_number_ + 1) + " is longer than " + std::to_string(kMaxLineBytes) +
-                            " bytes (not ECD text?)");
+                        "line " + std::to_string(line_number_ + 1) + " is longer than " +
+                            std::to_string(kMaxLineBytes) + " bytes (not ECD text?)");
     }
   }
 
@@ -227,7 +228,8 @@ class EcdTextEncoder final : public EventEncoder {
       Timestamp micros = batch.t[i] % kMicrosecondsPerSecond;
       const std::size_t fraction_start = out.size();
       out.resize(fraction_start + 6);
-      for (std::size_t digit = 6; digit-- > 0; micros /= 10) out[fraction_start + digit] = static_cast<std::uint8_t>('0' + micros % 10);
+      for (std::size_t digit = 6; digit-- > 0; micros /= 10)
+        out[fraction_start + digit] = static_cast<std::uint8_t>('0' + micros % 10);
       for (const char c : std::string_view("000 ")) out.push_back(static_cast<std::uint8_t>(c));
       append_decimal(batch.x[i], out);
       out.push_back(' ');

@@ -23,15 +23,24 @@ std::optional<EventFormat> parse_event_format(std::string_view name) {
 
 std::string_view format_name(EventFormat format) {
   switch (format) {
-    case EventFormat::EcdText: return "ecd";
-    case EventFormat::Evt2: return "evt2";
-    case EventFormat::Evt3: return "evt3";
-    case EventFormat::Evt21: return "evt21";
-    case EventFormat::Dat: return "dat";
-    case EventFormat::Aedat2: return "aedat2";
-    case EventFormat::Aedat31: return "aedat31";
-    case EventFormat::Aedat31Network: return "aedat31-net";
-    case EventFormat::EventStream: return "es";
+    case EventFormat::EcdText:
+      return "ecd";
+    case EventFormat::Evt2:
+      return "evt2";
+    case EventFormat::Evt3:
+      return "evt3";
+    case EventFormat::Evt21:
+      return "evt21";
+    case EventFormat::Dat:
+      return "dat";
+    case EventFormat::Aedat2:
+      return "aedat2";
+    case EventFormat::Aedat31:
+      return "aedat31";
+    case EventFormat::Aedat31Network:
+      return "aedat31-net";
+    case EventFormat::EventStream:
+      return "es";
   }
   return "unknown";
 }
@@ -118,7 +127,8 @@ std::size_t TextHeader::consume(std::span<const std::uint8_t> bytes, const std::
     line_.append(begin, end);
     used = static_cast<std::size_t>(end - bytes.data());
     if (line_.size() > kMaxHeaderLineBytes) {
-      throw FormatError(source, line_start_, "header line longer than " + std::to_string(kMaxHeaderLineBytes) + " bytes");
+      throw FormatError(source, line_start_,
+                        "header line longer than " + std::to_string(kMaxHeaderLineBytes) + " bytes");
     }
     if (newline == nullptr) break;
     ++used;  // the '\n'
@@ -157,18 +167,18 @@ constexpr KnownSystem kKnownSystems[] = {
     {0x15, "EVT2", kVga}, {0x17, "EVT2", kVga}, {0x97, "EVT2", kVga}, {0x19, "EVT2", kVga},  // Gen3.0
     {0x99, "EVT2", kVga}, {0x1D, "EVT2", kVga}, {0x21, "EVT2", kVga}, {0xA1, "EVT2", kVga},
     {0x1C, "EVT2", kVga}, {0x22, "EVT2", kVga}, {0xA2, "EVT2", kVga}, {0x23, "EVT2", kVga},  // Gen3.1
-    {0x29, "EVT2", kVga}, {0x28, "EVT3", kVga},
-    {0x1A, "EVT2", kHd},  {0x1F, "EVT2", kHd},  {0x1E, "EVT3", kHd},  {0x2E, "EVT3", kHd},  // Gen4.0
-    {0x27, "EVT2", kHd},  {0x30, "EVT3", kHd},                                              // Gen4.1
-    {0x31, "EVT3", kHd},  {0x32, "EVT3", kHd},                                              // IMX636
+    {0x29, "EVT2", kVga}, {0x28, "EVT3", kVga}, {0x1A, "EVT2", kHd},  {0x1F, "EVT2", kHd},
+    {0x1E, "EVT3", kHd},  {0x2E, "EVT3", kHd},  // Gen4.0
+    {0x27, "EVT2", kHd},  {0x30, "EVT3", kHd},  // Gen4.1
+    {0x31, "EVT3", kHd},  {0x32, "EVT3", kHd},  // IMX636
 };
 struct KnownPlugin {
   const char* name;
   SensorSize sensor;
 };
 constexpr KnownPlugin kKnownPlugins[] = {
-    {"hal_plugin_gen3_fx3", kVga},   {"hal_plugin_gen31_fx3", kVga},  {"hal_plugin_gen31_evk2", kVga},
-    {"hal_plugin_gen31_evk3", kVga}, {"hal_plugin_gen4_fx3", kHd},    {"hal_plugin_gen4_evk2", kHd},
+    {"hal_plugin_gen3_fx3", kVga},   {"hal_plugin_gen31_fx3", kVga}, {"hal_plugin_gen31_evk2", kVga},
+    {"hal_plugin_gen31_evk3", kVga}, {"hal_plugin_gen4_fx3", kHd},   {"hal_plugin_gen4_evk2", kHd},
     {"hal_plugin_gen41_evk2", kHd},  {"hal_plugin_gen41_evk3", kHd},
 };
 

@@ -40,7 +40,8 @@ class EventStreamDecoder final : public EventDecoder {
   }
 
   void finish(EventBatch&) override {
-    if (header_bytes_ < kHeaderBytes) throw FormatError(source_, header_bytes_, "file ends inside the Event Stream header");
+    if (header_bytes_ < kHeaderBytes)
+      throw FormatError(source_, header_bytes_, "file ends inside the Event Stream header");
     if (coordinates_ > 0) throw FormatError(source_, event_start_, "file ends inside an event");
   }
 
@@ -52,10 +53,12 @@ class EventStreamDecoder final : public EventDecoder {
     if (std::memcmp(header_.data(), kSignature.data(), kSignature.size()) != 0) {
       throw FormatError(source_, 0, "not an Event Stream file (no 'Event Stream' signature)");
     }
-    if (header_[12] != 2) throw FormatError(source_, 12, "Event Stream version " + std::to_string(header_[12]) + ".x (evldt reads 2.x)");
+    if (header_[12] != 2)
+      throw FormatError(source_, 12, "Event Stream version " + std::to_string(header_[12]) + ".x (evldt reads 2.x)");
     atis_ = header_[15] == 2;
     if (header_[15] != 1 && !atis_) {
-      throw FormatError(source_, 15, "Event Stream of type " + std::to_string(header_[15]) + " (evldt reads DVS 1 and ATIS 2)");
+      throw FormatError(source_, 15,
+                        "Event Stream of type " + std::to_string(header_[15]) + " (evldt reads DVS 1 and ATIS 2)");
     }
     const SensorSize size{load_le16(header_.data() + 16), load_le16(header_.data() + 18)};
     if (!size.valid()) throw FormatError(source_, 16, size.range_error());

@@ -8,15 +8,24 @@ namespace evldt {
 
 std::unique_ptr<EventDecoder> make_decoder(EventFormat format, std::string source_name) {
   switch (format) {
-    case EventFormat::EcdText: return detail::make_ecd_text_decoder(std::move(source_name));
-    case EventFormat::Evt2: return detail::make_evt2_decoder(std::move(source_name), RawFraming::WithHeader);
-    case EventFormat::Evt3: return detail::make_evt3_decoder(std::move(source_name), RawFraming::WithHeader);
-    case EventFormat::Evt21: return detail::make_evt21_decoder(std::move(source_name));
-    case EventFormat::Dat: return detail::make_dat_decoder(std::move(source_name));
-    case EventFormat::Aedat2: return detail::make_aedat2_decoder(std::move(source_name));
-    case EventFormat::Aedat31: return detail::make_aedat31_decoder(std::move(source_name));
-    case EventFormat::Aedat31Network: return detail::make_aedat31_network_decoder(std::move(source_name));
-    case EventFormat::EventStream: return detail::make_event_stream_decoder(std::move(source_name));
+    case EventFormat::EcdText:
+      return detail::make_ecd_text_decoder(std::move(source_name));
+    case EventFormat::Evt2:
+      return detail::make_evt2_decoder(std::move(source_name), RawFraming::WithHeader);
+    case EventFormat::Evt3:
+      return detail::make_evt3_decoder(std::move(source_name), RawFraming::WithHeader);
+    case EventFormat::Evt21:
+      return detail::make_evt21_decoder(std::move(source_name));
+    case EventFormat::Dat:
+      return detail::make_dat_decoder(std::move(source_name));
+    case EventFormat::Aedat2:
+      return detail::make_aedat2_decoder(std::move(source_name));
+    case EventFormat::Aedat31:
+      return detail::make_aedat31_decoder(std::move(source_name));
+    case EventFormat::Aedat31Network:
+      return detail::make_aedat31_network_decoder(std::move(source_name));
+    case EventFormat::EventStream:
+      return detail::make_event_stream_decoder(std::move(source_name));
   }
   throw std::invalid_argument("unknown event format");
 }
@@ -35,13 +44,15 @@ std::unique_ptr<EventDecoder> make_packet_decoder(std::string_view encoding, std
 namespace {
 
 std::string lowercase(std::string text) {
-  std::ranges::transform(text, text.begin(), [](char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; });
+  std::ranges::transform(text, text.begin(),
+                         [](char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; });
   return text;
 }
 
 }  // namespace
 
-EventStreamReader::EventStreamReader(const std::filesystem::path& path, std::optional<EventFormat> format, std::size_t chunk_bytes)
+EventStreamReader::EventStreamReader(const std::filesystem::path& path, std::optional<EventFormat> format,
+                                     std::size_t chunk_bytes)
     : EventStreamReader(std::make_unique<FileBytes>(path), format, path.extension().string(), chunk_bytes) {}
 
 EventStreamReader::EventStreamReader(std::unique_ptr<ByteSource> bytes, std::optional<EventFormat> format,
@@ -74,7 +85,8 @@ EventStreamReader::EventStreamReader(std::unique_ptr<ByteSource> bytes, std::opt
     } else if (lower_extension == ".dat") {
       format = EventFormat::Dat;
     } else {
-      throw std::runtime_error("cannot tell the format of '" + source + "' from its name: give it (ecd, evt2, evt3, evt21, dat)");
+      throw std::runtime_error("cannot tell the format of '" + source +
+                               "' from its name: give it (ecd, evt2, evt3, evt21, dat)");
     }
   }
 
@@ -88,9 +100,11 @@ EventStreamReader::EventStreamReader(std::unique_ptr<ByteSource> bytes, std::opt
     }
     if (format_from_header) {
       const auto encoding = header.encoding();
-      if (!encoding) throw FormatError(source, 0, "no '% evt' or '% format' header line tells the EVT version; give the format");
+      if (!encoding)
+        throw FormatError(source, 0, "no '% evt' or '% format' header line tells the EVT version; give the format");
       format = detail::raw_format_from_encoding(*encoding);
-      if (!format) throw FormatError(source, 0, "the header names the encoding " + *encoding + ", not EVT2, EVT21 or EVT3");
+      if (!format)
+        throw FormatError(source, 0, "the header names the encoding " + *encoding + ", not EVT2, EVT21 or EVT3");
     }
   }
   format_ = *format;

@@ -1,9 +1,9 @@
 #include "evldt/events/event_validator.hpp"
 
+#include <spdlog/spdlog.h>
 #include <algorithm>
 #include <bit>
 #include <limits>
-#include <spdlog/spdlog.h>
 
 namespace evldt {
 
@@ -23,7 +23,8 @@ bool on_sensor_and_in_order(const EventBatch& batch, std::size_t begin, std::siz
   const std::uint16_t* x = batch.x.data();
   const std::uint16_t* y = batch.y.data();
   unsigned off = 0;
-  for (std::size_t i = begin; i < end; ++i) off |= static_cast<unsigned>(x[i] > x_max) | static_cast<unsigned>(y[i] > y_max);
+  for (std::size_t i = begin; i < end; ++i)
+    off |= static_cast<unsigned>(x[i] > x_max) | static_cast<unsigned>(y[i] > y_max);
   // t[i] < t[i-1], as the sign bit of the overflow-corrected difference (SSE2 has no 64-bit compare).
   const Timestamp* t = batch.t.data();
   std::uint64_t back = 0;
@@ -53,7 +54,8 @@ std::size_t EventValidator::filter(EventBatch& batch) {
         on_sensor_and_in_order(batch, i, block_end, x_max, y_max)) {
       if (kept != i) {
         const auto move = [&](auto& column) {
-          std::copy(column.begin() + static_cast<std::ptrdiff_t>(i), column.begin() + static_cast<std::ptrdiff_t>(block_end),
+          std::copy(column.begin() + static_cast<std::ptrdiff_t>(i),
+                    column.begin() + static_cast<std::ptrdiff_t>(block_end),
                     column.begin() + static_cast<std::ptrdiff_t>(kept));
         };
         move(batch.t);
@@ -85,8 +87,10 @@ std::size_t EventValidator::filter(EventBatch& batch) {
           continue;
         }
         ++drops_.clock_resets;
-        spdlog::warn("event time went back from {}us to {}us for {} events in a row: following the new clock "
-                     "(clock reset {})", newest_, t, kClockResetRun, drops_.clock_resets);
+        spdlog::warn(
+            "event time went back from {}us to {}us for {} events in a row: following the new clock "
+            "(clock reset {})",
+            newest_, t, kClockResetRun, drops_.clock_resets);
         newest_ = t;
       }
       backwards_run_ = 0;

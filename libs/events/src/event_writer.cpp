@@ -9,7 +9,8 @@ namespace detail {
 
 void check_encodable(const EventBatch& batch, Timestamp previous_time, int max_coordinate, std::string_view format) {
   for (std::size_t i = 0; i < batch.size(); ++i) {
-    if (batch.t[i] < 0) throw std::invalid_argument("cannot encode the negative time " + std::to_string(batch.t[i]) + " us");
+    if (batch.t[i] < 0)
+      throw std::invalid_argument("cannot encode the negative time " + std::to_string(batch.t[i]) + " us");
     if (batch.t[i] < previous_time) {
       throw std::invalid_argument("events must be written in time order: event at " + std::to_string(batch.t[i]) +
                                   " us comes after one at " + std::to_string(previous_time) + " us");
@@ -17,7 +18,8 @@ void check_encodable(const EventBatch& batch, Timestamp previous_time, int max_c
     previous_time = batch.t[i];
     if (batch.x[i] > max_coordinate || batch.y[i] > max_coordinate) {
       throw std::invalid_argument(std::string(format) + " cannot encode pixel (" + std::to_string(batch.x[i]) + ", " +
-                                  std::to_string(batch.y[i]) + "): coordinates go up to " + std::to_string(max_coordinate));
+                                  std::to_string(batch.y[i]) + "): coordinates go up to " +
+                                  std::to_string(max_coordinate));
     }
   }
 }
@@ -29,8 +31,8 @@ void write_raw_header(std::string_view encoding, SensorSize sensor, std::vector<
   // byte order of its 64-bit words.
   const std::string evt_line = encoding == "EVT21" ? "" : "% evt " + std::string(encoding.substr(3)) + ".0\n";
   const std::string options = encoding == "EVT21" ? ";endianness=little" : "";
-  const std::string header = evt_line + "% format " + std::string(encoding) + options + ";height=" + height + ";width=" +
-                             width + "\n% geometry " + width + "x" + height + "\n% end\n";
+  const std::string header = evt_line + "% format " + std::string(encoding) + options + ";height=" + height +
+                             ";width=" + width + "\n% geometry " + width + "x" + height + "\n% end\n";
   out.insert(out.end(), header.begin(), header.end());
 }
 
@@ -38,15 +40,21 @@ void write_raw_header(std::string_view encoding, SensorSize sensor, std::vector<
 
 std::unique_ptr<EventEncoder> make_encoder(EventFormat format, SensorSize sensor) {
   switch (format) {
-    case EventFormat::EcdText: return detail::make_ecd_text_encoder();
-    case EventFormat::Evt2: return detail::make_evt2_encoder(sensor);
-    case EventFormat::Evt3: return detail::make_evt3_encoder(sensor);
-    case EventFormat::Evt21: return detail::make_evt21_encoder(sensor);
-    case EventFormat::Dat: return detail::make_dat_encoder(sensor);
+    case EventFormat::EcdText:
+      return detail::make_ecd_text_encoder();
+    case EventFormat::Evt2:
+      return detail::make_evt2_encoder(sensor);
+    case EventFormat::Evt3:
+      return detail::make_evt3_encoder(sensor);
+    case EventFormat::Evt21:
+      return detail::make_evt21_encoder(sensor);
+    case EventFormat::Dat:
+      return detail::make_dat_encoder(sensor);
     case EventFormat::Aedat2:
     case EventFormat::Aedat31:
     case EventFormat::Aedat31Network:
-    case EventFormat::EventStream: throw std::invalid_argument("evldt reads " + std::string(format_name(format)) + " but does not write it");
+    case EventFormat::EventStream:
+      throw std::invalid_argument("evldt reads " + std::string(format_name(format)) + " but does not write it");
   }
   throw std::invalid_argument("unknown event format");
 }

@@ -15,7 +15,8 @@ using namespace evt2;
 
 class Evt2Decoder final : public EventDecoder {
  public:
-  Evt2Decoder(std::string source, RawFraming framing) : source_(std::move(source)), bare_words_(framing == RawFraming::BareWords) {}
+  Evt2Decoder(std::string source, RawFraming framing)
+      : source_(std::move(source)), bare_words_(framing == RawFraming::BareWords) {}
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
     EventBatch::Appender out(batch);
@@ -51,13 +52,21 @@ class Evt2Decoder final : public EventDecoder {
       case kCdOff:
       case kCdOn:
         out.push_back(clock_.base_us() + ((word >> 22) & 0x3F), static_cast<std::uint16_t>((word >> 11) & 0x7FF),
-                      static_cast<std::uint16_t>(word & 0x7FF), (word >> 28) == kCdOn ? std::int8_t{1} : std::int8_t{-1});
+                      static_cast<std::uint16_t>(word & 0x7FF),
+                      (word >> 28) == kCdOn ? std::int8_t{1} : std::int8_t{-1});
         return;
-      case kTimeHigh: clock_.on_time_high(word); return;
-      case kExtTrigger: ++counts_.trigger_events; return;
+      case kTimeHigh:
+        clock_.on_time_high(word);
+        return;
+      case kExtTrigger:
+        ++counts_.trigger_events;
+        return;
       case kOthers:
-      case kContinued: return;
-      default: ++counts_.skipped_words; return;  // reserved: skipped as the vendor SDK does
+      case kContinued:
+        return;
+      default:
+        ++counts_.skipped_words;
+        return;  // reserved: skipped as the vendor SDK does
     }
   }
 
@@ -79,7 +88,8 @@ class Evt2Encoder final : public EventEncoder {
     check_encodable(batch, last_time_, kMaxCoordinate, "EVT 2.0");
     for (std::size_t i = 0; i < batch.size(); ++i) {
       const Timestamp t = batch.t[i];
-      time_high_.before_event(t, [&](std::uint32_t time_high) { append_le32(std::uint32_t{kTimeHigh} << 28 | time_high, out); });
+      time_high_.before_event(
+          t, [&](std::uint32_t time_high) { append_le32(std::uint32_t{kTimeHigh} << 28 | time_high, out); });
       const std::uint32_t type = batch.p[i] > 0 ? kCdOn : kCdOff;
       append_le32((type << 28) | (static_cast<std::uint32_t>(t & 0x3F) << 22) |
                       (static_cast<std::uint32_t>(batch.x[i]) << 11) | batch.y[i],

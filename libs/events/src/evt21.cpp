@@ -57,7 +57,8 @@ class Evt21Decoder final : public EventDecoder {
       throw FormatError(source_, 0, "the header says the data is " + *encoding + ", not EVT21");
     }
     if (const auto order = header_.option("endianness")) {
-      if (*order != "legacy" && *order != "little") throw FormatError(source_, 0, "unknown EVT 2.1 endianness '" + *order + "'");
+      if (*order != "legacy" && *order != "little")
+        throw FormatError(source_, 0, "unknown EVT 2.1 endianness '" + *order + "'");
       legacy_ = *order == "legacy";
     } else {
       const auto system = header_.system_id();
@@ -75,15 +76,23 @@ class Evt21Decoder final : public EventDecoder {
         const auto y = static_cast<std::uint16_t>((word >> 32) & 0x7FF);
         const std::int8_t polarity = (word >> 60) == kCdOn ? std::int8_t{1} : std::int8_t{-1};
         for (auto mask = static_cast<std::uint32_t>(word); mask != 0; mask &= mask - 1) {
-          out.push_back(t, static_cast<std::uint16_t>(x + static_cast<std::uint32_t>(std::countr_zero(mask))), y, polarity);
+          out.push_back(t, static_cast<std::uint16_t>(x + static_cast<std::uint32_t>(std::countr_zero(mask))), y,
+                        polarity);
         }
         return;
       }
-      case kTimeHigh: clock_.on_time_high(static_cast<std::uint32_t>(word >> 32)); return;
-      case kExtTrigger: ++counts_.trigger_events; return;
+      case kTimeHigh:
+        clock_.on_time_high(static_cast<std::uint32_t>(word >> 32));
+        return;
+      case kExtTrigger:
+        ++counts_.trigger_events;
+        return;
       case kOthers:
-      case kContinued: return;
-      default: ++counts_.skipped_words; return;
+      case kContinued:
+        return;
+      default:
+        ++counts_.skipped_words;
+        return;
     }
   }
 

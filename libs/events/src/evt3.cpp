@@ -48,7 +48,8 @@ std::int8_t polarity_of(std::uint16_t word) { return (word & 0x800) != 0 ? std::
 
 class Evt3Decoder final : public EventDecoder {
  public:
-  Evt3Decoder(std::string source, RawFraming framing) : source_(std::move(source)), bare_words_(framing == RawFraming::BareWords) {}
+  Evt3Decoder(std::string source, RawFraming framing)
+      : source_(std::move(source)), bare_words_(framing == RawFraming::BareWords) {}
 
   void decode(std::span<const std::uint8_t> chunk, EventBatch& batch) override {
     if (!bare_words_ && !header_.complete()) {
@@ -66,7 +67,8 @@ class Evt3Decoder final : public EventDecoder {
 
   void finish(EventBatch& /*out*/) override {
     if (!bare_words_) header_.finish(source_);
-    if (words_.carried() > 0) throw FormatError(source_, words_.offset(), "file ends inside an EVT 3.0 word (1 of 2 bytes)");
+    if (words_.carried() > 0)
+      throw FormatError(source_, words_.offset(), "file ends inside an EVT 3.0 word (1 of 2 bytes)");
   }
 
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return header_.geometry(); }
@@ -111,9 +113,15 @@ class Evt3Decoder final : public EventDecoder {
         s.base_x = word & 0x7FF;
         s.vector_polarity = polarity_of(word);
         return;
-      case kVect12: emit_vector(word & kTwelveBits, 12, s, out); return;
-      case kVect8: emit_vector(word & 0xFF, 8, s, out); return;
-      case kTimeLow: s.time_low = word & kTwelveBits; return;
+      case kVect12:
+        emit_vector(word & kTwelveBits, 12, s, out);
+        return;
+      case kVect8:
+        emit_vector(word & 0xFF, 8, s, out);
+        return;
+      case kTimeLow:
+        s.time_low = word & kTwelveBits;
+        return;
       case kTimeHigh: {
         const std::uint16_t time_high = word & kTwelveBits;
         if (s.has_time && s.time_high >= time_high + kTimeHighHalfRange) s.wraps += 1;
@@ -124,11 +132,16 @@ class Evt3Decoder final : public EventDecoder {
         s.time_high_us = (s.wraps << kTimeBits) + (static_cast<Timestamp>(time_high) << kTimeLowBits);
         return;
       }
-      case kExtTrigger: ++s.counts.trigger_events; return;
+      case kExtTrigger:
+        ++s.counts.trigger_events;
+        return;
       case kContinued4:
       case kOthers:
-      case kContinued12: return;
-      default: ++s.counts.skipped_words; return;  // reserved, e.g. the 0x9999 padding of some IMX636 cameras
+      case kContinued12:
+        return;
+      default:
+        ++s.counts.skipped_words;
+        return;  // reserved, e.g. the 0x9999 padding of some IMX636 cameras
     }
   }
 

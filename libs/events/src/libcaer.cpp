@@ -42,12 +42,14 @@ class LibcaerDecoder final : public EventDecoder {
         return;
       }
       out.push_back(base_us_ + wrap_us_ + time, static_cast<std::uint16_t>(data >> 17),
-                    static_cast<std::uint16_t>((data >> 2) & 0x7FFF), (data & 2u) != 0 ? std::int8_t{1} : std::int8_t{-1});
+                    static_cast<std::uint16_t>((data >> 2) & 0x7FFF),
+                    (data & 2u) != 0 ? std::int8_t{1} : std::int8_t{-1});
     });
   }
 
   void finish(EventBatch&) override {
-    if (records_.carried() > 0) throw FormatError(source_, records_.offset(), "libcaer data ends inside an 8-byte event");
+    if (records_.carried() > 0)
+      throw FormatError(source_, records_.offset(), "libcaer data ends inside an 8-byte event");
   }
   [[nodiscard]] std::optional<SensorSize> geometry() const override { return std::nullopt; }
   [[nodiscard]] DecodeCounts counts() const override { return counts_; }
@@ -76,10 +78,18 @@ class LibcaerCompressedDecoder final : public EventDecoder {
       const std::uint16_t word = load_le16(bytes);
       const std::uint16_t payload = word & 0xFFF;
       switch (word >> 12) {
-        case 0: time_high_ = payload; return;
-        case 1: time_low_ = payload; return;
-        case 2: x_ = payload & 0x7FF; return;
-        case 3: out.push_back(time_us(), x_, payload & 0x7FF, polarity_of(payload)); return;
+        case 0:
+          time_high_ = payload;
+          return;
+        case 1:
+          time_low_ = payload;
+          return;
+        case 2:
+          x_ = payload & 0x7FF;
+          return;
+        case 3:
+          out.push_back(time_us(), x_, payload & 0x7FF, polarity_of(payload));
+          return;
         case 4:
           base_y_ = payload & 0x7FF;
           polarity_ = polarity_of(payload);
@@ -92,7 +102,9 @@ class LibcaerCompressedDecoder final : public EventDecoder {
           base_y_ = static_cast<std::uint16_t>(base_y_ + 8);
           return;
         }
-        default: ++counts_.skipped_words; return;
+        default:
+          ++counts_.skipped_words;
+          return;
       }
     });
   }
@@ -104,7 +116,9 @@ class LibcaerCompressedDecoder final : public EventDecoder {
   [[nodiscard]] DecodeCounts counts() const override { return counts_; }
 
  private:
-  static std::int8_t polarity_of(std::uint16_t payload) { return (payload & 0x800) != 0 ? std::int8_t{1} : std::int8_t{-1}; }
+  static std::int8_t polarity_of(std::uint16_t payload) {
+    return (payload & 0x800) != 0 ? std::int8_t{1} : std::int8_t{-1};
+  }
   [[nodiscard]] Timestamp time_us() const { return base_us_ + ((Timestamp{time_high_} << 12) | time_low_); }
 
   std::string source_;

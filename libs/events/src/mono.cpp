@@ -21,8 +21,9 @@ class MonoDecoder final : public EventDecoder {
     EventBatch::Appender out(batch);
     words_.feed(chunk, [&](const std::uint8_t* word, std::uint64_t) {
       const std::uint32_t high = load_le32(word + 4);
-      out.push_back(base_us_ + static_cast<Timestamp>((base_ns_left_ + load_le32(word)) / 1000), static_cast<std::uint16_t>(high & 0xFFFF),
-                    static_cast<std::uint16_t>((high >> 16) & 0x7FFF), (high >> 31) != 0 ? std::int8_t{1} : std::int8_t{-1});
+      out.push_back(base_us_ + static_cast<Timestamp>((base_ns_left_ + load_le32(word)) / 1000),
+                    static_cast<std::uint16_t>(high & 0xFFFF), static_cast<std::uint16_t>((high >> 16) & 0x7FFF),
+                    (high >> 31) != 0 ? std::int8_t{1} : std::int8_t{-1});
     });
   }
   void finish(EventBatch&) override {

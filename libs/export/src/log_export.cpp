@@ -7,8 +7,8 @@
 
 #include "evldt/containers/mcap_writer.hpp"
 #include "evldt/export/foxglove_json.hpp"
-#include "evldt/pipeline/pipeline_config.hpp"
 #include "evldt/media/media.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 #include "evldt/render/scene_renderer.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"
 #include "evldt/transport/channels.hpp"
@@ -20,7 +20,8 @@ namespace evldt {
 namespace {
 
 bool same_camera(const std::string& a, const std::string& b) {
-  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return std::toupper(x) == std::toupper(y); });
+  return a.size() == b.size() &&
+         std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return std::toupper(x) == std::toupper(y); });
 }
 
 /// The camera of the first EVENTS_* channel, or empty.
@@ -37,21 +38,26 @@ std::string first_camera(const std::filesystem::path& path) {
 
 LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const std::filesystem::path& mcap_path,
                                    const LogExportOptions& options) {
-  if (!(options.image_hz > 0 && options.image_hz <= 1000)) throw std::invalid_argument("picture rate must be in (0, 1000] Hz");
+  if (!(options.image_hz > 0 && options.image_hz <= 1000))
+    throw std::invalid_argument("picture rate must be in (0, 1000] Hz");
   if (options.scale < 1 || options.scale > 8) throw std::invalid_argument("scale must be in 1..8");
-  if (options.jpeg_quality < 1 || options.jpeg_quality > 100) throw std::invalid_argument("JPEG quality must be in 1..100");
+  if (options.jpeg_quality < 1 || options.jpeg_quality > 100)
+    throw std::invalid_argument("JPEG quality must be in 1..100");
   LcmLogReader log(log_path);
   LcmLogReader::Record record;
   LogExportCounts counts;
   counts.camera = options.camera.empty() ? first_camera(log_path) : options.camera;
-  if (counts.camera.empty()) throw std::runtime_error("no event batches (EVENTS_* channel) in LCM log " + log_path.string());
+  if (counts.camera.empty())
+    throw std::runtime_error("no event batches (EVENTS_* channel) in LCM log " + log_path.string());
   for (char& c : counts.camera) c = static_cast<char>(std::tolower(c));
   const std::string events = events_channel(counts.camera), lines = lines_channel(counts.camera),
                     whole_lines = whole_lines_channel(counts.camera);
 
   McapWriter mcap(mcap_path);
-  const std::uint16_t image_schema = mcap.add_schema("foxglove.CompressedImage", "jsonschema", compressed_image_schema());
-  const std::uint16_t annotations_schema = mcap.add_schema("foxglove.ImageAnnotations", "jsonschema", image_annotations_schema());
+  const std::uint16_t image_schema =
+      mcap.add_schema("foxglove.CompressedImage", "jsonschema", compressed_image_schema());
+  const std::uint16_t annotations_schema =
+      mcap.add_schema("foxglove.ImageAnnotations", "jsonschema", image_annotations_schema());
   const std::uint16_t stats_schema_id = mcap.add_schema("evldt.Stats", "jsonschema", stats_schema());
   const std::string prefix = "/" + counts.camera + "/";
   const std::uint16_t image_channel = mcap.add_channel(image_schema, prefix + "events", "json");
@@ -124,7 +130,8 @@ LogExportCounts export_log_to_mcap(const std::filesystem::path& log_path, const 
         continue;
       }
       if (!camera_info_channel_id) {
-        const std::uint16_t schema = mcap.add_schema("foxglove.CameraCalibration", "jsonschema", camera_calibration_schema());
+        const std::uint16_t schema =
+            mcap.add_schema("foxglove.CameraCalibration", "jsonschema", camera_calibration_schema());
         camera_info_channel_id = mcap.add_channel(schema, prefix + "camera_info", "json");
       }
       mcap.write(*camera_info_channel_id, time_ns, camera_calibration_json(time_ns, info));

@@ -13,10 +13,11 @@ AntiFlickerFilter::AntiFlickerFilter(const AntiFlickerParams& params) : params_(
 }
 
 void check_params(const AntiFlickerParams& params) {
-  if (!(params.min_hz > 16) || !(params.max_hz > params.min_hz) || params.lock_periods < 1 || params.lock_periods > 255 ||
-      !(params.tolerance > 0 && params.tolerance < 0.5) || params.burst_gap_us <= 0) {
-    throw std::invalid_argument("anti-flicker: a band above 16 Hz (its lowest below its highest), 1-255 lock periods, a "
-                                "tolerance in (0, 0.5) and a positive burst gap");
+  if (!(params.min_hz > 16) || !(params.max_hz > params.min_hz) || params.lock_periods < 1 ||
+      params.lock_periods > 255 || !(params.tolerance > 0 && params.tolerance < 0.5) || params.burst_gap_us <= 0) {
+    throw std::invalid_argument(
+        "anti-flicker: a band above 16 Hz (its lowest below its highest), 1-255 lock periods, a "
+        "tolerance in (0, 0.5) and a positive burst gap");
   }
 }
 

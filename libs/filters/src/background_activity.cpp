@@ -15,7 +15,8 @@ BackgroundActivityFilter::BackgroundActivityFilter(SensorSize sensor, Timestamp 
 }
 
 void BackgroundActivityFilter::check_params(Timestamp window_us, double min_noise_hz) {
-  if (window_us <= 0 || window_us > 1'000'000'000) throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
+  if (window_us <= 0 || window_us > 1'000'000'000)
+    throw std::invalid_argument("the background-activity window must be in 1 us .. 1000 s");
   if (!(min_noise_hz >= 0)) throw std::invalid_argument("the background-activity noise level must not be negative");
 }
 

@@ -22,7 +22,8 @@ std::vector<std::string> parse_filter_chain(const std::string& text) {
     const std::size_t comma = std::min(text.find(',', start), text.size());
     const std::string name = text.substr(start, comma - start);
     if (std::ranges::find(filter_names(), name) == filter_names().end()) {
-      throw std::invalid_argument("unknown filter '" + name + "' (filters: none, or hot-pixel, background-activity, refractory, anti-flicker)");
+      throw std::invalid_argument("unknown filter '" + name +
+                                  "' (filters: none, or hot-pixel, background-activity, refractory, anti-flicker)");
     }
     if (std::ranges::find(chain, name) != chain.end()) throw std::invalid_argument("filter '" + name + "' given twice");
     chain.push_back(name);
@@ -39,8 +40,10 @@ std::string format_filter_chain(const std::vector<std::string>& chain) {
 
 void check_filter_config(const FilterConfig& config) {
   for (auto name = config.chain.begin(); name != config.chain.end(); ++name) {
-    if (std::ranges::find(filter_names(), *name) == filter_names().end()) throw std::invalid_argument("unknown filter '" + *name + "'");
-    if (std::find(config.chain.begin(), name, *name) != name) throw std::invalid_argument("filter '" + *name + "' given twice");
+    if (std::ranges::find(filter_names(), *name) == filter_names().end())
+      throw std::invalid_argument("unknown filter '" + *name + "'");
+    if (std::find(config.chain.begin(), name, *name) != name)
+      throw std::invalid_argument("filter '" + *name + "' given twice");
   }
   BackgroundActivityFilter::check_params(config.background_window_us, config.background_min_noise_hz);
   RefractoryFilter::check_params(config.refractory_us);
@@ -146,8 +149,8 @@ struct FilterChain::Pass {
   }
 
   template <Kind K>
-  static bool test(FilterChain& chain, Timestamp t, std::size_t x, std::size_t y, std::int8_t p, std::uint32_t pixel, PixelState* states,
-                   std::uint32_t* counts, std::uint32_t* surface, std::size_t stride) {
+  static bool test(FilterChain& chain, Timestamp t, std::size_t x, std::size_t y, std::int8_t p, std::uint32_t pixel,
+                   PixelState* states, std::uint32_t* counts, std::uint32_t* surface, std::size_t stride) {
     if constexpr (K == Kind::HotPixel) {
       return chain.hot_pixel_->pass(t, pixel, counts);
     } else if constexpr (K == Kind::AntiFlicker) {
@@ -200,7 +203,8 @@ FilterChain::FilterChain(const FilterConfig& config, SensorSize sensor) : width_
   const std::size_t pixels = static_cast<std::size_t>(sensor.width) * static_cast<std::size_t>(sensor.height);
   const std::size_t record_bytes = refractory_ || anti_flicker_ ? pixels * sizeof(PixelState) : 0;
   const std::size_t count_bytes = hot_pixel_ ? pixels * sizeof(std::uint32_t) : 0;
-  const std::size_t surface_bytes = background_activity_ ? BackgroundActivityFilter::surface_size(sensor) * sizeof(std::uint32_t) : 0;
+  const std::size_t surface_bytes =
+      background_activity_ ? BackgroundActivityFilter::surface_size(sensor) * sizeof(std::uint32_t) : 0;
   const std::size_t table_bytes = record_bytes + count_bytes + surface_bytes;
   if (table_bytes > 0) {
     table_ = std::unique_ptr<std::byte, Unmap>(map_zeroed(table_bytes), Unmap{mapped_size(table_bytes)});

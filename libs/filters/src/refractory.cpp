@@ -13,7 +13,8 @@ RefractoryFilter::RefractoryFilter(SensorSize sensor, Timestamp period_us)
 }
 
 void RefractoryFilter::check_params(Timestamp period_us) {
-  if (period_us <= 0 || period_us > 1'000'000'000) throw std::invalid_argument("the refractory period must be in 1 us .. 1000 s");
+  if (period_us <= 0 || period_us > 1'000'000'000)
+    throw std::invalid_argument("the refractory period must be in 1 us .. 1000 s");
 }
 
 void RefractoryFilter::sweep(Timestamp t, PixelState* states) {

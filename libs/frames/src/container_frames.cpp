@@ -2,7 +2,6 @@
 // 4.0, 3.1 and 2.0): each image,
 // through the conversion its pixel encoding names, to the 8-bit grey frame LSD runs on.
 
-
 #include <opencv2/imgproc.hpp>
 
 #include "evldt/containers/image_source.hpp"
@@ -24,8 +23,8 @@ cv::Mat grey_of(const RecordingImage& image, const std::string& name) {
     throw FrameError(name + ": pixel encoding '" + encoding + "' is not one evldt reads (mono8, mono16, bgr8, rgb8)");
   }
   if (image.step < std::uint64_t{image.width} * static_cast<std::uint64_t>(channels * depth)) {
-    throw FrameError(name + ": rows of " + std::to_string(image.step) + " bytes are too short for " + std::to_string(image.width) + " " +
-                     encoding + " pixels");
+    throw FrameError(name + ": rows of " + std::to_string(image.step) + " bytes are too short for " +
+                     std::to_string(image.width) + " " + encoding + " pixels");
   }
   const int rows = static_cast<int>(image.height), cols = static_cast<int>(image.width);
   cv::Mat grey;
@@ -52,7 +51,8 @@ cv::Mat grey_of(const RecordingImage& image, const std::string& name) {
 
 class ImageFrameReader final : public FrameReader {
  public:
-  ImageFrameReader(std::unique_ptr<ImageSource> images, SensorSize sensor) : images_(std::move(images)), sensor_(sensor) {}
+  ImageFrameReader(std::unique_ptr<ImageSource> images, SensorSize sensor)
+      : images_(std::move(images)), sensor_(sensor) {}
 
   std::optional<Frame> next() override {
     RecordingImage image;
@@ -71,8 +71,8 @@ class ImageFrameReader final : public FrameReader {
     }
     if (image.width > kMaxSide || image.height > kMaxSide ||
         !fits_sensor(sensor_, static_cast<int>(image.width), static_cast<int>(image.height))) {
-      throw FrameError(location + ": frame is " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", the sensor " +
-                       std::to_string(sensor_.width) + "x" + std::to_string(sensor_.height));
+      throw FrameError(location + ": frame is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                       ", the sensor " + std::to_string(sensor_.width) + "x" + std::to_string(sensor_.height));
     }
     frame.image = grey_of(image, location);
     started_ = true;
@@ -102,7 +102,8 @@ SensorSize frames_sensor_size(const std::filesystem::path& path, const std::stri
   return {first->image.cols, first->image.rows};
 }
 
-std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream, SensorSize sensor) {
+std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream,
+                                         SensorSize sensor) {
   if (std::filesystem::is_directory(path) || path.filename() == "images.txt") return open_ecd_frames(path, sensor);
   std::unique_ptr<ImageSource> images;
   try {
@@ -112,7 +113,8 @@ std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, cons
   }
   if (images) return std::make_unique<ImageFrameReader>(std::move(images), sensor);
   if (auto video = open_video_frames(path, sensor)) return video;
-  throw FrameError(path.string() + ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 or 2 bag or MCAP "
+  throw FrameError(path.string() +
+                   ": not a source of frames evldt reads (an ECD folder with images.txt, a ROS 1 or 2 bag or MCAP "
                    "file, MVSEC's HDF5, an AEDAT 4.0, 3.1 or 2.0 recording, a video file)");
 }
 

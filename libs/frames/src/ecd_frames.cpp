@@ -33,11 +33,12 @@ class EcdFrameReader final : public FrameReader {
       frame.t_us = std::llround(seconds * 1e6);
       frame.name = (folder_ / file).string();
       if (started_ && frame.t_us < last_us_) {
-        throw FrameError(where() + ": frame " + frame.name + " at " + std::to_string(frame.t_us) + " us is earlier than the one before (" +
-                         std::to_string(last_us_) + " us)");
+        throw FrameError(where() + ": frame " + frame.name + " at " + std::to_string(frame.t_us) +
+                         " us is earlier than the one before (" + std::to_string(last_us_) + " us)");
       }
       // Checked first: OpenCV would log its own warning for a missing file.
-      if (!std::filesystem::is_regular_file(frame.name)) throw FrameError(where() + ": frame " + frame.name + " is missing");
+      if (!std::filesystem::is_regular_file(frame.name))
+        throw FrameError(where() + ": frame " + frame.name + " is missing");
       frame.image = media::read_image(frame.name, cv::IMREAD_GRAYSCALE);
       if (frame.image.empty()) throw FrameError(where() + ": frame " + frame.name + " is not an image");
       if (!fits_sensor(sensor_, frame.image.cols, frame.image.rows)) {
@@ -68,7 +69,8 @@ class EcdFrameReader final : public FrameReader {
 
 std::unique_ptr<FrameReader> open_ecd_frames(const std::filesystem::path& path, SensorSize sensor) {
   const std::filesystem::path list = std::filesystem::is_directory(path) ? path / "images.txt" : path;
-  if (!std::filesystem::is_regular_file(list)) throw FrameError(list.string() + ": no frame list (ECD layout: images.txt and images/)");
+  if (!std::filesystem::is_regular_file(list))
+    throw FrameError(list.string() + ": no frame list (ECD layout: images.txt and images/)");
   return std::make_unique<EcdFrameReader>(list, sensor);
 }
 

@@ -25,8 +25,8 @@ class VideoFrameReader final : public FrameReader {
     frame.name = path_ + ", frame " + std::to_string(index_);
     frame.t_us = video_frame_time_us(index_++, fps_);
     if (!fits_sensor(sensor_, image_.cols, image_.rows)) {
-      throw FrameError(frame.name + " is " + std::to_string(image_.cols) + "x" + std::to_string(image_.rows) + ", the sensor " +
-                       std::to_string(sensor_.width) + "x" + std::to_string(sensor_.height));
+      throw FrameError(frame.name + " is " + std::to_string(image_.cols) + "x" + std::to_string(image_.rows) +
+                       ", the sensor " + std::to_string(sensor_.width) + "x" + std::to_string(sensor_.height));
     }
     if (image_.channels() == 1) {
       image_.copyTo(frame.image);
@@ -48,7 +48,9 @@ class VideoFrameReader final : public FrameReader {
 
 }  // namespace
 
-Timestamp video_frame_time_us(std::uint64_t index, double fps) { return static_cast<Timestamp>(static_cast<double>(index) * 1e6 / fps); }
+Timestamp video_frame_time_us(std::uint64_t index, double fps) {
+  return static_cast<Timestamp>(static_cast<double>(index) * 1e6 / fps);
+}
 
 std::unique_ptr<FrameReader> open_video_frames(const std::filesystem::path& path, SensorSize sensor) {
   media::VideoCapture capture;

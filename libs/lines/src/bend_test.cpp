@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <bit>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 
 #include <Eigen/Dense>
 
@@ -12,15 +12,15 @@
 namespace evldt {
 
 namespace {
-constexpr float kBandRatio = 0.4f;     // of b: events this far across the segment are fitted
-constexpr float kFairScale = 1.0f;     // px: robust weight 1 / (1 + |residual| / scale)
+constexpr float kBandRatio = 0.4f;  // of b: events this far across the segment are fitted
+constexpr float kFairScale = 1.0f;  // px: robust weight 1 / (1 + |residual| / scale)
 constexpr int kReweights = 3;
-constexpr float kMinBendPx = 2.0f;     // px: pixel noise alone bends a fit over three blocks of 8-10 px this much
-constexpr float kMaxTilt = 0.7f;       // |linear| / |quadratic| above this: one end lifted alone, a corner
-constexpr float kOnStraight = 0.3f;    // px: an event this close to the segment's line continues it
-constexpr float kMinStraight = 0.6f;   // share of an end's far bins holding such an event: it runs on straight
-constexpr float kOnCurve = 1.5f;       // px: an event this close to the fitted curve follows it
-constexpr float kMinOnCurve = 0.6f;    // share of each end's bins that must hold such an event
+constexpr float kMinBendPx = 2.0f;    // px: pixel noise alone bends a fit over three blocks of 8-10 px this much
+constexpr float kMaxTilt = 0.7f;      // |linear| / |quadratic| above this: one end lifted alone, a corner
+constexpr float kOnStraight = 0.3f;   // px: an event this close to the segment's line continues it
+constexpr float kMinStraight = 0.6f;  // share of an end's far bins holding such an event: it runs on straight
+constexpr float kOnCurve = 1.5f;      // px: an event this close to the fitted curve follows it
+constexpr float kMinOnCurve = 0.6f;   // share of each end's bins that must hold such an event
 }  // namespace
 
 BendTest::BendTest(const LatticeGeometry& geometry, float max_bend_ratio)
@@ -53,7 +53,8 @@ bool BendTest::runs_straight(const ScarfLattice& lattice, const Frame& frame, Po
   const float cx = frame.centre.x(), cy = frame.centre.y(), nx = frame.normal.x(), ny = frame.normal.y();
   const float ox = outward.x(), oy = outward.y();
   const Point2 middle = end + (0.75f * static_cast<float>(b)) * outward;
-  const int cell = geometry_.index(nearest_region(middle.x(), geometry_.blocks_x), nearest_region(middle.y(), geometry_.blocks_y));
+  const int cell =
+      geometry_.index(nearest_region(middle.x(), geometry_.blocks_x), nearest_region(middle.y(), geometry_.blocks_y));
   // Whether an entry lies in the band there is data (about one in six does): branches on it
   // mispredict. A first loop the compiler vectorises works out each entry's offset and its key:
   // its bin when on the segment's line, kInBand when only in the band, kOutside. A second marks
@@ -74,7 +75,8 @@ bool BendTest::runs_straight(const ScarfLattice& lattice, const Frame& frame, Po
       const float dy = (static_cast<float>(block.pixel_y(entries[i])) + 0.5f) - cy;
       const float v = dx * nx + dy * ny;
       const float beyond = (dx * ox + dy * oy) - half_length;
-      const bool inside = (std::abs(v) <= band) & (beyond >= static_cast<float>(near)) & (beyond < static_cast<float>(b));
+      const bool inside =
+          (std::abs(v) <= band) & (beyond >= static_cast<float>(near)) & (beyond < static_cast<float>(b));
       const std::int32_t bin = static_cast<std::int32_t>(beyond) - near;
       entry_offsets[i] = v;
       entry_keys[i] = !inside ? kOutside : std::abs(v) <= kOnStraight ? bin : kInBand;
@@ -173,7 +175,8 @@ bool BendTest::bent(const ScarfLattice& lattice, const Segment& segment) {
       const float u = dx * ux + dy * uy, v = dx * nx + dy * ny;
       entry_along[i] = u;
       entry_offsets[i] = v;
-      entry_keys[i] = static_cast<std::int32_t>(std::abs(v) <= band) & static_cast<std::int32_t>(std::abs(u) <= half_span);
+      entry_keys[i] =
+          static_cast<std::int32_t>(std::abs(v) <= band) & static_cast<std::int32_t>(std::abs(u) <= half_span);
     }
     u_.resize(n + count);
     v_.resize(n + count);

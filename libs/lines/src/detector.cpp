@@ -16,12 +16,14 @@ LineDetector::LineDetector(const LatticeGeometry& geometry, const ScoreParams& p
     : geometry_(geometry),
       params_(params),
       round_workers_(workers),
-      retry_after_(static_cast<std::uint16_t>(std::clamp(std::floor(params.retry_share * static_cast<float>(geometry.capacity)), 0.0f, 65535.0f))) {
+      retry_after_(static_cast<std::uint16_t>(
+          std::clamp(std::floor(params.retry_share * static_cast<float>(geometry.capacity)), 0.0f, 65535.0f))) {
   const int threads = workers ? workers->threads() : 1;
   const float b = static_cast<float>(geometry.block_size);
   workers_.reserve(static_cast<std::size_t>(threads));
   for (int w = 0; w < threads; ++w) {
-    Worker& worker = workers_.emplace_back(Worker{FittingScorer(params.inlier_distance_ratio * b, b * 1.5f), BendTest(geometry, params.max_bend_ratio), {}});
+    Worker& worker = workers_.emplace_back(Worker{
+        FittingScorer(params.inlier_distance_ratio * b, b * 1.5f), BendTest(geometry, params.max_bend_ratio), {}});
     worker.points.reserve(static_cast<std::size_t>(geometry.capacity));
   }
   failed_at_.assign(static_cast<std::size_t>(geometry.block_count()), kNeverFailed);
@@ -78,7 +80,9 @@ void LineDetector::detect_row(const ScarfLattice& lattice, LineMap& lines, int r
     const std::uint64_t version = lattice.version(block);
     const std::uint16_t arrivals = lattice.active_arrivals(block);
     if (failed_at_[block] == version) continue;
-    if (failed_at_[block] != kNeverFailed && static_cast<std::uint16_t>(arrivals - failed_arrivals_[block]) < retry_after_) continue;
+    if (failed_at_[block] != kNeverFailed &&
+        static_cast<std::uint16_t>(arrivals - failed_arrivals_[block]) < retry_after_)
+      continue;
     failed_at_[block] = version;  // until it succeeds below
     failed_arrivals_[block] = arrivals;
     worker.points.clear();

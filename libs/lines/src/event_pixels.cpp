@@ -44,8 +44,10 @@ bool EventPixels::any_within(Point2 at, float radius) {
   const float x = at.x() - static_cast<float>(region.origin_x), y = at.y() - static_cast<float>(region.origin_y);
   const float r = std::min(radius, 0.5f * static_cast<float>(block_size_));
   const float r_squared = r * r;
-  const int y0 = std::max(0, static_cast<int>(std::ceil(y - r))), y1 = std::min(extent - 1, static_cast<int>(std::floor(y + r)));
-  const int x0 = std::max(0, static_cast<int>(std::ceil(x - r))), x1 = std::min(extent - 1, static_cast<int>(std::floor(x + r)));
+  const int y0 = std::max(0, static_cast<int>(std::ceil(y - r))),
+            y1 = std::min(extent - 1, static_cast<int>(std::floor(y + r)));
+  const int x0 = std::max(0, static_cast<int>(std::ceil(x - r))),
+            x1 = std::min(extent - 1, static_cast<int>(std::floor(x + r)));
   for (int py = y0; py <= y1; ++py) {
     const float dy = static_cast<float>(py) - y;
     const std::uint8_t* row = map + static_cast<std::size_t>(py) * static_cast<std::size_t>(extent);

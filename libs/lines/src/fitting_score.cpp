@@ -17,7 +17,8 @@ ScoreBreakdown FittingScorer::score(const Segment& segment, const PointSet& poin
   // A bin per pixel of length, one byte each, and a spare one past them for the points that are no
   // inliers (a bitset's read-modify-write of one word per point made each point wait for the
   // previous one's store: half of the scoring time).
-  const std::size_t bin_count = std::min(static_cast<std::size_t>(length) + 1, bins_.size() - 1);  // floor(d2) ranges over 0..floor(|L|)
+  const std::size_t bin_count =
+      std::min(static_cast<std::size_t>(length) + 1, bins_.size() - 1);  // floor(d2) ranges over 0..floor(|L|)
   std::fill_n(bins_.begin(), bin_count + 1, std::uint8_t{0});
 
   // Two passes. The first is branch-free arithmetic the compiler vectorises: each point's bin, or
@@ -40,8 +41,8 @@ ScoreBreakdown FittingScorer::score(const Segment& segment, const PointSet& poin
   std::int32_t inliers = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const float ox = xs[i] - q0x, oy = ys[i] - q0y;
-    const float position = ox * ux + oy * uy;            // d2
-    const float offset = oy * ux - ox * uy;  // along the normal (-uy, ux); d1 is its size
+    const float position = ox * ux + oy * uy;  // d2
+    const float offset = oy * ux - ox * uy;    // along the normal (-uy, ux); d1 is its size
     const bool inlier = (std::abs(offset) < max_distance) & (position >= 0.0f) & (position <= length);
     point_bins[i] = inlier ? std::min(static_cast<std::int32_t>(position), last_bin) : spare_bin;
     point_offsets[i] = inlier ? offset : 0.0f;

@@ -10,11 +10,16 @@ namespace evldt {
 
 std::string_view reason_name(ReleaseReason reason) {
   switch (reason) {
-    case ReleaseReason::TooFewPoints: return "too-few-points";
-    case ReleaseReason::TooShort: return "too-short";
-    case ReleaseReason::LeftSensor: return "left-sensor";
-    case ReleaseReason::BadTracks: return "bad-tracks";
-    case ReleaseReason::LostOwnership: return "lost-ownership";
+    case ReleaseReason::TooFewPoints:
+      return "too-few-points";
+    case ReleaseReason::TooShort:
+      return "too-short";
+    case ReleaseReason::LeftSensor:
+      return "left-sensor";
+    case ReleaseReason::BadTracks:
+      return "bad-tracks";
+    case ReleaseReason::LostOwnership:
+      return "lost-ownership";
   }
   return "?";
 }
@@ -80,7 +85,8 @@ std::uint64_t LineMap::add(const Segment& segment, float score, int admin_block,
 float LineMap::offset_along(const Segment& line, Point2 direction, Point2 centre) const {
   const Point2 along = line.q1 - line.q0;
   const float length = along.norm();
-  if (!(length > 0) || std::abs(direction.dot(along)) < min_cos_angle_ * length) return std::numeric_limits<float>::infinity();
+  if (!(length > 0) || std::abs(direction.dot(along)) < min_cos_angle_ * length)
+    return std::numeric_limits<float>::infinity();
   return std::abs(cross2(along, centre - line.q0)) / length;
 }
 
@@ -131,8 +137,8 @@ void LineMap::release(std::size_t index, ReleaseReason reason) {
   const int block = lines_[index].admin_block;
   const TrackedLine& gone = lines_[index];
   released_lifetimes_.add(gone.last_good_us - gone.first_seen_us);
-  released_by_block_[static_cast<std::size_t>(block)] = {true, gone.id, gone.segment, gone.first_seen_us, gone.last_good_us,
-                                                         motion_[index]};
+  released_by_block_[static_cast<std::size_t>(block)] = {
+      true, gone.id, gone.segment, gone.first_seen_us, gone.last_good_us, motion_[index]};
   status_[block] = BlockStatus::NoDetect;
   owner_[block] = -1;
   if (index + 1 != lines_.size()) {

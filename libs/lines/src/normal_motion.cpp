@@ -25,7 +25,8 @@ void start_motion(NormalMotion& motion, const Segment& segment, Timestamp t_us, 
             .started = true};
 }
 
-void observe_motion(NormalMotion& motion, const Segment& segment, Point2 at, Timestamp t_us, const MotionParams& params) {
+void observe_motion(NormalMotion& motion, const Segment& segment, Point2 at, Timestamp t_us,
+                    const MotionParams& params) {
   Point2 n = unit_normal(segment);
   if (!motion.started || n.isZero()) {
     if (!n.isZero()) start_motion(motion, segment, t_us, params);

@@ -25,8 +25,12 @@ void blocks_along(const Segment& segment, const LatticeGeometry& geometry, std::
   constexpr float kInf = std::numeric_limits<float>::infinity();
   const float delta_x = d.x() != 0 ? 1.0f / std::abs(d.x()) : kInf;
   const float delta_y = d.y() != 0 ? 1.0f / std::abs(d.y()) : kInf;
-  float next_x = d.x() != 0 ? (step_i > 0 ? (static_cast<float>(ci) + 1 - a.x()) : (a.x() - static_cast<float>(ci))) * delta_x : kInf;
-  float next_y = d.y() != 0 ? (step_j > 0 ? (static_cast<float>(cj) + 1 - a.y()) : (a.y() - static_cast<float>(cj))) * delta_y : kInf;
+  float next_x = d.x() != 0
+                     ? (step_i > 0 ? (static_cast<float>(ci) + 1 - a.x()) : (a.x() - static_cast<float>(ci))) * delta_x
+                     : kInf;
+  float next_y = d.y() != 0
+                     ? (step_j > 0 ? (static_cast<float>(cj) + 1 - a.y()) : (a.y() - static_cast<float>(cj))) * delta_y
+                     : kInf;
   // Rounding can make the walk overshoot the end cell by one; the count bound stops it there.
   const int steps = std::abs(end_i - ci) + std::abs(end_j - cj);
   for (int s = 0; s <= steps; ++s) {
@@ -74,7 +78,8 @@ LineTracker::LineTracker(const LatticeGeometry& geometry, const ScoreParams& sco
     : geometry_(geometry), score_params_(score), params_(track), round_workers_(workers) {
   const int threads = workers ? workers->threads() : 1;
   const float inlier_distance = score.inlier_distance_ratio * static_cast<float>(geometry.block_size);
-  const float diagonal = std::hypot(static_cast<float>(geometry.sensor.width), static_cast<float>(geometry.sensor.height));
+  const float diagonal =
+      std::hypot(static_cast<float>(geometry.sensor.width), static_cast<float>(geometry.sensor.height));
   const auto longest_walk = static_cast<std::size_t>(geometry.blocks_x + geometry.blocks_y + 2);
   workers_.reserve(static_cast<std::size_t>(threads));
   for (int w = 0; w < threads; ++w) {
@@ -106,9 +111,10 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
       if (begin >= n) return;
       for (std::size_t i = begin; i < std::min(n, begin + kLinesPerClaim); ++i) {
         ReleaseReason reason{};
-        outcome_[i] = track_line(lattice, all[i], lines.settled_version(i), lines.band_centre(i), now, settled_ok, worker, reason)
-                          ? kKept
-                          : static_cast<std::uint8_t>(reason);
+        outcome_[i] =
+            track_line(lattice, all[i], lines.settled_version(i), lines.band_centre(i), now, settled_ok, worker, reason)
+                ? kKept
+                : static_cast<std::uint8_t>(reason);
       }
     }
   };
@@ -133,7 +139,8 @@ void LineTracker::track(const ScarfLattice& lattice, LineMap& lines, Timestamp n
 }
 
 bool LineTracker::track_line(const ScarfLattice& lattice, TrackedLine& line, std::uint64_t& settled_version,
-                             Point2& band_centre, Timestamp now, bool settled_ok, Worker& worker, ReleaseReason& reason) const {
+                             Point2& band_centre, Timestamp now, bool settled_ok, Worker& worker,
+                             ReleaseReason& reason) const {
   const float b = static_cast<float>(geometry_.block_size);
   if (line.segment.length() < 0.5f * b) {
     reason = ReleaseReason::TooShort;

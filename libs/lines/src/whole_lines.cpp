@@ -82,7 +82,8 @@ WholeLineTracker::WholeLineTracker(int block_size, const WholeLineParams& params
       first_id_(first_id),
       next_id_(first_id) {
   if (first_id == 0) throw std::invalid_argument("whole-line ids start above 0");
-  if (block_size <= 0) throw std::invalid_argument("whole lines need a positive block size, got " + std::to_string(block_size));
+  if (block_size <= 0)
+    throw std::invalid_argument("whole lines need a positive block size, got " + std::to_string(block_size));
 }
 
 bool WholeLineTracker::fits(const LineModel& line, const Segment& segment, float relax, float gap_relax) const {
@@ -135,13 +136,15 @@ float WholeLineTracker::held_reach(Point2 from, Point2 to, float spread) const {
     if (last_held > 0 && length - last_held <= max_run) return length;
     // A pixel nearer `from` than the tolerance may be held by the segments' own events at `from`.
     const float radius = 1.5f + spread * distance;
-    if (distance > radius && event_pixels_.any_within(from + (to - from) * (distance / length), radius)) last_held = distance;
+    if (distance > radius && event_pixels_.any_within(from + (to - from) * (distance / length), radius))
+      last_held = distance;
   }
   return last_held;
 }
 
 std::uint64_t WholeLineTracker::former_track_of(std::uint64_t segment_id) const {
-  const auto it = std::lower_bound(track_of_segment_id_.begin(), track_of_segment_id_.end(), std::pair(segment_id, std::uint64_t{0}));
+  const auto it = std::lower_bound(track_of_segment_id_.begin(), track_of_segment_id_.end(),
+                                   std::pair(segment_id, std::uint64_t{0}));
   return it != track_of_segment_id_.end() && it->first == segment_id ? it->second : kNoKey;
 }
 
@@ -204,10 +207,12 @@ std::size_t WholeLineTracker::first_fit_along(const LineModel& line, std::span<c
   const int samples = 1 + static_cast<int>(std::ceil(length / cell_size_));
   std::size_t found = kNone;
   for (int i = 0; i <= samples && found == kNone; ++i) {
-    const Point2 at = line.point + (line.t_min + length * static_cast<float>(i) / static_cast<float>(samples)) * line.direction;
+    const Point2 at =
+        line.point + (line.t_min + length * static_cast<float>(i) / static_cast<float>(samples)) * line.direction;
     end_grid_.for_each_near(at, [&](std::uint32_t end_index) {
       const std::uint32_t k = end_index / 2;
-      if (found == kNone && cluster_of_segment_[k] == kUnassigned && fits(line, segments[k].segment, kLooseJoin, 1.0f)) found = k;
+      if (found == kNone && cluster_of_segment_[k] == kUnassigned && fits(line, segments[k].segment, kLooseJoin, 1.0f))
+        found = k;
     });
   }
   return found;
@@ -497,7 +502,8 @@ void WholeLineTracker::follow_track(std::size_t k, Timestamp t, bool take_back, 
   cluster.model = expected;
   cluster.first_member = members_.size();
   auto it = std::lower_bound(segments_of_former_track_.begin(), segments_of_former_track_.end(),
-                             std::pair(track.key, std::uint32_t{0}), [](const auto& a, const auto& b) { return a.first < b.first; });
+                             std::pair(track.key, std::uint32_t{0}),
+                             [](const auto& a, const auto& b) { return a.first < b.first; });
   for (; take_back && it != segments_of_former_track_.end() && it->first == track.key; ++it) {
     // Its former segments are taken back along its last geometry until those taken back span
     // enough to fit a direction of their own: one tilted segment taken back first (the longest,
@@ -525,12 +531,14 @@ std::uint32_t WholeLineTracker::members_of(std::size_t c) const {
   return static_cast<std::uint32_t>(end - clusters_[c].first_member);
 }
 
-void WholeLineTracker::carry_tracks_over(Timestamp t, std::size_t first_new_cluster, std::span<const TrackedLine> segments) {
+void WholeLineTracker::carry_tracks_over(Timestamp t, std::size_t first_new_cluster,
+                                         std::span<const TrackedLine> segments) {
   next_tracks_.clear();
   next_track_of_segment_id_.clear();
   const auto take_ownership = [&](std::size_t c, std::uint64_t key) {
     const std::size_t first = clusters_[c].first_member;
-    for (std::size_t m = first; m < first + members_of(c); ++m) next_track_of_segment_id_.emplace_back(segments[members_[m]].id, key);
+    for (std::size_t m = first; m < first + members_of(c); ++m)
+      next_track_of_segment_id_.emplace_back(segments[members_[m]].id, key);
   };
   for (std::size_t k = 0; k < tracks_.size(); ++k) {
     Track& track = tracks_[k];
@@ -546,8 +554,12 @@ void WholeLineTracker::carry_tracks_over(Timestamp t, std::size_t first_new_clus
     next_tracks_.push_back(track);
   }
   for (std::size_t c = first_new_cluster; c < clusters_.size(); ++c) {
-    Track track{.key = next_key_++, .model = clusters_[c].model, .first_seen_us = t, .last_seen_us = t,
-                .end_seen_us = {t, t}, .segments = members_of(c)};
+    Track track{.key = next_key_++,
+                .model = clusters_[c].model,
+                .first_seen_us = t,
+                .last_seen_us = t,
+                .end_seen_us = {t, t},
+                .segments = members_of(c)};
     std::tie(track.velocity, track.velocity_std) = cluster_motion(c, members_of(c), segments);
     take_ownership(c, track.key);
     next_tracks_.push_back(track);

@@ -17,7 +17,8 @@ namespace {
 // The places the module is looked for, in order (media.hpp).
 std::vector<std::string> module_candidates() {
   std::vector<std::string> candidates;
-  if (const char* given = std::getenv("EVLDT_MEDIA_MODULE"); given != nullptr && *given != '\0') candidates.emplace_back(given);
+  if (const char* given = std::getenv("EVLDT_MEDIA_MODULE"); given != nullptr && *given != '\0')
+    candidates.emplace_back(given);
   Dl_info self{};
   if (dladdr(reinterpret_cast<void*>(&module_candidates), &self) != 0 && self.dli_fname != nullptr) {
     const std::filesystem::path folder = std::filesystem::path(self.dli_fname).parent_path();
@@ -52,7 +53,8 @@ const ModuleApi* load_module() {
     dlclose(handle);
   }
   throw std::runtime_error("evldt: image and video files need the module " EVLDT_MEDIA_MODULE_NAME
-                           " (OpenCV's imgcodecs and videoio); looked for it at:" + tried);
+                           " (OpenCV's imgcodecs and videoio); looked for it at:" +
+                           tried);
 }
 
 const ModuleApi& module() {
@@ -123,7 +125,9 @@ bool VideoCapture::open(int index) {
 
 bool VideoCapture::read(cv::Mat& frame) { return handle_ != nullptr && module().read_frame(handle_, frame); }
 
-double VideoCapture::get(int property) const { return handle_ != nullptr ? module().capture_property(handle_, property) : 0.0; }
+double VideoCapture::get(int property) const {
+  return handle_ != nullptr ? module().capture_property(handle_, property) : 0.0;
+}
 
 void VideoCapture::release() {
   if (handle_ != nullptr) module().close_capture(std::exchange(handle_, nullptr));

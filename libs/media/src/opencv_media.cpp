@@ -52,9 +52,9 @@ double capture_property(void* capture, int property) { return static_cast<cv::Vi
 
 void close_capture(void* capture) { delete static_cast<cv::VideoCapture*>(capture); }
 
-constexpr ModuleApi kApi{ModuleApi::kVersion, write_image,       read_image,          encode_image, open_writer,
-                         write_frame,          close_writer,      open_capture_file,   open_capture_camera,
-                         read_frame,           capture_property,  close_capture};
+constexpr ModuleApi kApi{ModuleApi::kVersion, write_image, read_image,       encode_image,
+                         open_writer,         write_frame, close_writer,     open_capture_file,
+                         open_capture_camera, read_frame,  capture_property, close_capture};
 
 }  // namespace
 }  // namespace evldt::media

@@ -1,8 +1,8 @@
 #include "evldt/nodes/camera_node.hpp"
 
+#include <spdlog/spdlog.h>
 #include <bit>
 #include <chrono>
-#include <spdlog/spdlog.h>
 #include <stdexcept>
 #include <utility>
 
@@ -21,7 +21,8 @@ void CameraSummary::print(std::FILE* out) const {
   std::fprintf(out,
                "evldt-camera summary\n"
                "  source            %s (%dx%d)%s\n"
-               "  events            %llu read, %llu published, %llu dropped (%llu off sensor, %llu back in time), %llu clock resets\n"
+               "  events            %llu read, %llu published, %llu dropped (%llu off sensor, %llu back in time), %llu "
+               "clock resets\n"
                "  batches           %llu (%.1f events each), %.2f MB, %.2f bytes/event, %llu publish failures\n"
                "  time              %.3f s of events in %.3f s wall (%.2fx), %.2f Mev/s, %llu loop restarts\n"
                "  pace              furthest behind: %.1f ms, %llu jumps of event time not waited through\n"
@@ -29,18 +30,21 @@ void CameraSummary::print(std::FILE* out) const {
                source.c_str(), sensor.width, sensor.height, input_error.empty() ? "" : (" -- " + input_error).c_str(),
                static_cast<unsigned long long>(events_read), static_cast<unsigned long long>(events_published),
                static_cast<unsigned long long>(drops.total()), static_cast<unsigned long long>(drops.off_sensor),
-               static_cast<unsigned long long>(drops.time_backwards), static_cast<unsigned long long>(drops.clock_resets),
-               static_cast<unsigned long long>(batches),
+               static_cast<unsigned long long>(drops.time_backwards),
+               static_cast<unsigned long long>(drops.clock_resets), static_cast<unsigned long long>(batches),
                batches ? static_cast<double>(events_published) / static_cast<double>(batches) : 0.0,
                static_cast<double>(bytes) * 1e-6,
                events_published ? static_cast<double>(bytes) / static_cast<double>(events_published) : 0.0,
                static_cast<unsigned long long>(publish_failures), event_seconds, wall_seconds,
                wall_seconds > 0 ? event_seconds / wall_seconds : 0.0, rate * 1e-6,
                static_cast<unsigned long long>(loops), max_lag_s * 1e3, static_cast<unsigned long long>(skipped_gaps),
-               static_cast<unsigned long long>(decoded.skipped_words), static_cast<unsigned long long>(decoded.trigger_events));
+               static_cast<unsigned long long>(decoded.skipped_words),
+               static_cast<unsigned long long>(decoded.trigger_events));
   if (live) {
-    std::fprintf(out, "  live lag          sensor -> publish: median %.1f ms, p99 %.1f ms beyond the quickest batch (%u batches); wall - sensor clock %.3f s\n"
-                      "  live input        %llu reconnects\n",
+    std::fprintf(out,
+                 "  live lag          sensor -> publish: median %.1f ms, p99 %.1f ms beyond the quickest batch (%u "
+                 "batches); wall - sensor clock %.3f s\n"
+                 "  live input        %llu reconnects\n",
                  sensor_lag.median_ms, sensor_lag.p99_ms, sensor_lag.samples, sensor_clock_offset_s,
                  static_cast<unsigned long long>(reconnects));
   }
@@ -58,12 +62,17 @@ CameraNode::CameraNode(lcm::LCM& lcm, CameraNodeOptions options, std::int64_t ep
 class CameraNode::Run {
  public:
   Run(CameraNode& node, const SourceFactory& open_source, const std::atomic<bool>& stop)
-      : node_(node), options_(node.options_), open_source_(open_source), stop_(stop), source_(open_source()),
+      : node_(node),
+        options_(node.options_),
+        open_source_(open_source),
+        stop_(stop),
+        source_(open_source()),
         validator_(sensor_of(*source_, options_), options_.time_slack_us),
         batcher_(options_.batch_us, options_.max_batch),
         live_(source_->live()),
         pacer_(live_ ? 0.0 : options_.speed) {
-    if (live_ && options_.loop) throw std::invalid_argument("--loop replays a recording; " + source_->name() + " cannot be read again");
+    if (live_ && options_.loop)
+      throw std::invalid_argument("--loop replays a recording; " + source_->name() + " cannot be read again");
     summary_.source = source_->name();
     summary_.sensor = sensor_of(*source_, options_);
     summary_.live = live_;
@@ -100,7 +109,8 @@ class CameraNode::Run {
   /// The sensor size the options give, else the source's header's; throws without one.
   static SensorSize sensor_of(const EventSource& source, const CameraNodeOptions& options) {
     const std::optional<SensorSize> sensor = options.sensor ? options.sensor : source.geometry();
-    if (!sensor) throw std::runtime_error(source.name() + " has no sensor size in its header: pass --width and --height");
+    if (!sensor)
+      throw std::runtime_error(source.name() + " has no sensor size in its header: pass --width and --height");
     if (!sensor->valid()) throw std::runtime_error(sensor->range_error());
     return *sensor;
   }
@@ -151,7 +161,8 @@ class CameraNode::Run {
   }
 
   void progress() {
-    if (options_.progress_period_s <= 0 || Clock::now() - last_progress_ <= std::chrono::duration<double>(options_.progress_period_s)) {
+    if (options_.progress_period_s <= 0 ||
+        Clock::now() - last_progress_ <= std::chrono::duration<double>(options_.progress_period_s)) {
       return;
     }
     last_progress_ = Clock::now();
@@ -231,7 +242,8 @@ void CameraNode::publish(const EventBatch& batch, CameraSummary& summary) {
   encode_event_batch(header, batch, wire_);
   if (lcm_.publish(channel_, wire_.data(), static_cast<unsigned>(wire_.size())) != 0) {
     // The sequence number still advances: subscribers count the batch as lost.
-    if (std::has_single_bit(++summary.publish_failures)) spdlog::warn("{} batch publish(es) failed", summary.publish_failures);
+    if (std::has_single_bit(++summary.publish_failures))
+      spdlog::warn("{} batch publish(es) failed", summary.publish_failures);
   } else {
     if (!first_published_t_) first_published_t_ = batch.t.front();
     summary.event_seconds = static_cast<double>(batch.t.back() - *first_published_t_) * 1e-6;

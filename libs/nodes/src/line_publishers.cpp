@@ -1,7 +1,7 @@
 #include "evldt/nodes/line_publishers.hpp"
 
-#include <algorithm>
 #include <spdlog/spdlog.h>
+#include <algorithm>
 
 #include "evldt/pipeline/thread_name.hpp"
 #include "evldt/transport/channels.hpp"
@@ -19,7 +19,8 @@ Clock::duration period_of(double hz) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / hz));
 }
 
-void fill_header(const ListHeader& header, std::int64_t epoch_us, const std::string& camera, std::int64_t seq, segment_list_t& msg) {
+void fill_header(const ListHeader& header, std::int64_t epoch_us, const std::string& camera, std::int64_t seq,
+                 segment_list_t& msg) {
   msg.utime = header.utime;
   msg.epoch = epoch_us;
   msg.seq = seq;
@@ -33,8 +34,8 @@ void fill_header(const ListHeader& header, std::int64_t epoch_us, const std::str
 
 // --- segment lists ---------------------------------------------------------------------------------
 
-SegmentListPublisher::SegmentListPublisher(lcm::LCM& lcm, const LinesNodeOptions& options, std::int64_t epoch_us, LinesIngest& ingest,
-                                           WholeLinePublisher* whole_lines)
+SegmentListPublisher::SegmentListPublisher(lcm::LCM& lcm, const LinesNodeOptions& options, std::int64_t epoch_us,
+                                           LinesIngest& ingest, WholeLinePublisher* whole_lines)
     : lcm_(lcm),
       options_(options),
       epoch_us_(epoch_us),
@@ -42,7 +43,8 @@ SegmentListPublisher::SegmentListPublisher(lcm::LCM& lcm, const LinesNodeOptions
       ingest_(ingest),
       whole_lines_(whole_lines) {}
 
-void SegmentListPublisher::wait_for_round(const std::shared_ptr<RealtimeEngine>& engine, Clock::time_point until) const {
+void SegmentListPublisher::wait_for_round(const std::shared_ptr<RealtimeEngine>& engine,
+                                          Clock::time_point until) const {
   engine->wait_for_round(published_engine_ == engine ? published_version_ : 0, until);
 }
 
@@ -50,7 +52,8 @@ bool SegmentListPublisher::publish(bool heartbeat) {
   const auto engine = ingest_.engine();
   if (!engine) return false;  // nothing received yet
   const bool same_engine = engine == published_engine_;
-  if (same_engine && !heartbeat && engine->lines_version() == published_version_) return false;  // no round since the last list
+  if (same_engine && !heartbeat && engine->lines_version() == published_version_)
+    return false;  // no round since the last list
   const RealtimeEngine::LinesState state = engine->snapshot(lines_);
   published_engine_ = engine;
   published_version_ = state.version;
@@ -81,7 +84,8 @@ void SegmentListPublisher::hand_on(const std::shared_ptr<RealtimeEngine>& engine
     last_shed_ = now;
   }
   const bool shedding = shed_seen_ > 0 && now - last_shed_ < kSheddingMemory;
-  const double whole_hz = shedding ? std::min(options_.whole_lines_hz, options_.whole_lines_loaded_hz) : options_.whole_lines_hz;
+  const double whole_hz =
+      shedding ? std::min(options_.whole_lines_hz, options_.whole_lines_loaded_hz) : options_.whole_lines_hz;
   const Timestamp event_period_us = static_cast<Timestamp>(1e6 / whole_hz) - engine->config().schedule.track_period_us;
   const Timestamp lattice_us = header.t_us;
   const bool due = now >= next_whole_list_ && (engine != whole_engine_handed_ || lattice_us < whole_time_handed_ ||
@@ -112,8 +116,13 @@ bool CameraInfoPublisher::publish(const RealtimeEngine& engine) {
 
 // --- whole lines -----------------------------------------------------------------------------------
 
-WholeLinePublisher::WholeLinePublisher(lcm::LCM& lcm, const LinesNodeOptions& options, std::int64_t epoch_us, std::uint64_t first_id)
-    : lcm_(lcm), options_(options), epoch_us_(epoch_us), channel_(whole_lines_channel(options.camera)), next_id_(first_id) {}
+WholeLinePublisher::WholeLinePublisher(lcm::LCM& lcm, const LinesNodeOptions& options, std::int64_t epoch_us,
+                                       std::uint64_t first_id)
+    : lcm_(lcm),
+      options_(options),
+      epoch_us_(epoch_us),
+      channel_(whole_lines_channel(options.camera)),
+      next_id_(first_id) {}
 
 void WholeLinePublisher::hand_over(const std::shared_ptr<RealtimeEngine>& engine, std::span<const TrackedLine> lines,
                                    const ListHeader& header, bool shedding) {

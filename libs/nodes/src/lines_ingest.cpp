@@ -1,8 +1,8 @@
 #include "evldt/nodes/lines_ingest.hpp"
 
+#include <spdlog/spdlog.h>
 #include <bit>
 #include <stdexcept>
-#include <spdlog/spdlog.h>
 
 #include "evldt/pipeline/thread_name.hpp"
 #include "evldt/transport/channels.hpp"
@@ -40,7 +40,8 @@ LinesIngest::LinesIngest(const LinesNodeOptions& options, std::uint64_t first_li
                     return LatticeGeometry::fits(size, options_.configure(size).lattice.block_size);
                   } catch (const std::invalid_argument& error) {
                     if (std::has_single_bit(++sizes_refused_)) {  // the 1st, 2nd, 4th, ... time
-                      spdlog::warn("a {}x{} sensor refused ({} time(s)): {}", size.width, size.height, sizes_refused_, error.what());
+                      spdlog::warn("a {}x{} sensor refused ({} time(s)): {}", size.width, size.height, sizes_refused_,
+                                   error.what());
                     }
                     return false;
                   }
@@ -92,7 +93,8 @@ LatencySummary LinesIngest::take_latency_summary() {
   return latency_.take_summary();
 }
 
-void LinesIngest::queue(std::span<const std::uint8_t> payload, std::int64_t received_utime, const std::atomic<bool>& stop) {
+void LinesIngest::queue(std::span<const std::uint8_t> payload, std::int64_t received_utime,
+                        const std::atomic<bool>& stop) {
   queue_.push(payload, received_utime, stop);
 }
 
@@ -144,15 +146,16 @@ void LinesIngest::start_engine() {
   if (engine_) {
     engine_->stop();  // the publisher may still snapshot it meanwhile
     retired = engine_->counters();
-    spdlog::warn("camera {} restarted (epoch {}) or its clock went back: lattice and lines begin afresh", options_.camera,
-                 receiver_.message().epoch);
+    spdlog::warn("camera {} restarted (epoch {}) or its clock went back: lattice and lines begin afresh",
+                 options_.camera, receiver_.message().epoch);
   } else {
     const SensorSize sensor = *receiver_.sensor();
     spdlog::info("first batch on {}: {}x{} sensor from '{}'", events_channel(options_.camera), sensor.width,
                  sensor.height, receiver_.message().source);
   }
   // The engine built at start for a configured sensor serves the first batch; a restart needs a fresh one.
-  auto engine = prebuilt_ ? std::move(prebuilt_) : make_engine(*receiver_.sensor(), next_line_id_ + retired.lines_created);
+  auto engine =
+      prebuilt_ ? std::move(prebuilt_) : make_engine(*receiver_.sensor(), next_line_id_ + retired.lines_created);
   prebuilt_.reset();
   spdlog::info("engine: b={}, rounds on {} thread(s)", engine->config().lattice.block_size, engine->config().threads);
   std::lock_guard lock(mutex_);

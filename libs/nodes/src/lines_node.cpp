@@ -17,34 +17,46 @@ namespace evldt {
 void LinesNodeTotals::print(std::FILE* out, const LinesNodeOptions& options) const {
   const SequenceCounts& sequence = receiver.sequence;
   fmt::print(out, "evldt-lines summary\n");
-  fmt::print(out, "  batches   {} received, {} lost (sequence gaps), {} late ({} resyncs), {} invalid messages, {} camera restarts\n",
-             sequence.received, sequence.lost, sequence.late, sequence.resyncs, receiver.invalid_messages, engine_restarts);
+  fmt::print(out,
+             "  batches   {} received, {} lost (sequence gaps), {} late ({} resyncs), {} invalid messages, {} camera "
+             "restarts\n",
+             sequence.received, sequence.lost, sequence.late, sequence.resyncs, receiver.invalid_messages,
+             engine_restarts);
   fmt::print(out, "  shed      {} events, not stored: {} batches shed whole, {} thinned (latency budget {:.0f} ms)\n",
              receiver.events_shed, receiver.batches_shed, receiver.batches_thinned, options.max_latency_ms);
-  fmt::print(out, "  events    {} received, {} stored, {} dropped as invalid ({} off sensor, {} back in time), {} clock resets\n",
-             events_received, events_stored, receiver.drops.total(), receiver.drops.off_sensor, receiver.drops.time_backwards,
-             receiver.drops.clock_resets);
-  fmt::print(out, "  filters   dropped {} hot-pixel, {} background-activity, {} refractory, {} anti-flicker\n", filtered.hot_pixel,
-             filtered.background_activity, filtered.refractory, filtered.anti_flicker);
+  fmt::print(
+      out,
+      "  events    {} received, {} stored, {} dropped as invalid ({} off sensor, {} back in time), {} clock resets\n",
+      events_received, events_stored, receiver.drops.total(), receiver.drops.off_sensor, receiver.drops.time_backwards,
+      receiver.drops.clock_resets);
+  fmt::print(out, "  filters   dropped {} hot-pixel, {} background-activity, {} refractory, {} anti-flicker\n",
+             filtered.hot_pixel, filtered.background_activity, filtered.refractory, filtered.anti_flicker);
   if (events_off_rectified > 0) {  // with a calibration
-    fmt::print(out, "  calibration  {} events left out, their pixel sees beyond the rectified image\n", events_off_rectified);
+    fmt::print(out, "  calibration  {} events left out, their pixel sees beyond the rectified image\n",
+               events_off_rectified);
   }
-  fmt::print(out, "  loops     {} detection rounds ({} while shedding, without the bend test), {} tracking rounds\n", detect_rounds,
-             detect_rounds_without_bend_test, track_rounds);
-  fmt::print(out, "  output    {} lines created, {} segment lists published, {} whole-line lists ({} at {} Hz while shedding)\n",
-             lines_created, lists_published, whole_lists_published, whole_lists_while_shedding, options.whole_lines_loaded_hz);
+  fmt::print(out, "  loops     {} detection rounds ({} while shedding, without the bend test), {} tracking rounds\n",
+             detect_rounds, detect_rounds_without_bend_test, track_rounds);
+  fmt::print(
+      out,
+      "  output    {} lines created, {} segment lists published, {} whole-line lists ({} at {} Hz while shedding)\n",
+      lines_created, lists_published, whole_lists_published, whole_lists_while_shedding, options.whole_lines_loaded_hz);
   // A replayed log keeps the recording's publish stamps: measured from them, nothing late would read as lag.
   const bool from_receipt = latency_from_receipt > 0;
-  fmt::print(out, "  latency   batch {} -> segment list: median {:.1f} ms, p99 {:.1f} ms ({} batches); settled, from 1 s after\n",
-             from_receipt ? "receipt" : "publish", latency.median_ms, latency.p99_ms, latency.samples);
-  fmt::print(out, "            the first batch: median {:.1f} ms, p99 {:.1f} ms ({} batches)\n", settled_latency.median_ms,
-             settled_latency.p99_ms, settled_latency.samples);
+  fmt::print(
+      out,
+      "  latency   batch {} -> segment list: median {:.1f} ms, p99 {:.1f} ms ({} batches); settled, from 1 s after\n",
+      from_receipt ? "receipt" : "publish", latency.median_ms, latency.p99_ms, latency.samples);
+  fmt::print(out, "            the first batch: median {:.1f} ms, p99 {:.1f} ms ({} batches)\n",
+             settled_latency.median_ms, settled_latency.p99_ms, settled_latency.samples);
   if (from_receipt) {
-    fmt::print(out,
-               "            measured from receipt for {} batches: their publish stamps are {:.1f} ms {} this host's clock\n"
-               "            (a log replayed by lcm-logplayer keeps the recording's, or the camera host's clock is set apart)\n",
-               latency_from_receipt, std::abs(static_cast<double>(publish_clock_offset_us.value_or(0))) * 1e-3,
-               publish_clock_offset_us.value_or(0) >= 0 ? "behind" : "ahead of");
+    fmt::print(
+        out,
+        "            measured from receipt for {} batches: their publish stamps are {:.1f} ms {} this host's clock\n"
+        "            (a log replayed by lcm-logplayer keeps the recording's, or the camera host's clock is set "
+        "apart)\n",
+        latency_from_receipt, std::abs(static_cast<double>(publish_clock_offset_us.value_or(0))) * 1e-3,
+        publish_clock_offset_us.value_or(0) >= 0 ? "behind" : "ahead of");
   }
 }
 
@@ -53,15 +65,17 @@ LinesNode::LinesNode(lcm::LCM& lcm, LinesNodeOptions options, std::int64_t epoch
       options_(std::move(options)),
       ingest_(options_, static_cast<std::uint64_t>(epoch_us)),
       whole_lines_(options_.whole_lines ? std::optional<WholeLinePublisher>(std::in_place, lcm, options_, epoch_us,
-                                                                             static_cast<std::uint64_t>(epoch_us))
+                                                                            static_cast<std::uint64_t>(epoch_us))
                                         : std::nullopt),
       segments_(lcm, options_, epoch_us, ingest_, whole_lines_ ? &*whole_lines_ : nullptr),
       statistics_(lcm, options_, epoch_us),
       camera_info_(lcm, options_, epoch_us) {
-  if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) || !(options_.stats_hz > 0 && options_.stats_hz <= 100) ||
+  if (!(options_.publish_hz > 0 && options_.publish_hz <= 10000) ||
+      !(options_.stats_hz > 0 && options_.stats_hz <= 100) ||
       !(options_.whole_lines_hz > 0 && options_.whole_lines_hz <= 10000) ||
       !(options_.whole_lines_loaded_hz > 0 && options_.whole_lines_loaded_hz <= 10000)) {
-    throw std::invalid_argument("publish and whole-line rates must be in (0, 10000] Hz and the stats rate in (0, 100] Hz");
+    throw std::invalid_argument(
+        "publish and whole-line rates must be in (0, 10000] Hz and the stats rate in (0, 100] Hz");
   }
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
   const std::vector<pid_t> threads_before = process_thread_ids();
@@ -98,7 +112,8 @@ LinesNode::~LinesNode() {
 
 void LinesNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
   // Only queued here (waiting while the queue is full), so that LCM's own queue stays short.
-  ingest_.queue(std::span(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size), buffer->recv_utime, *stop_);
+  ingest_.queue(std::span(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size), buffer->recv_utime,
+                *stop_);
 }
 
 void LinesNode::run(const std::atomic<bool>& stop) {
@@ -128,7 +143,8 @@ void LinesNode::publish_loop(const std::atomic<bool>& stop) {
   // unchanged one again after a second (a heartbeat, so a subscriber sees the service live).
   constexpr auto kHeartbeat = std::chrono::seconds(1);
   constexpr auto kLongestWait = std::chrono::milliseconds(100);  // the stop flag is checked this often
-  constexpr auto kCameraInfoPeriod = std::chrono::milliseconds(250);  // with a calibration: a subscriber waits no longer
+  constexpr auto kCameraInfoPeriod =
+      std::chrono::milliseconds(250);  // with a calibration: a subscriber waits no longer
   const auto publish_period = period_of(options_.publish_hz);
   const auto stats_period = period_of(options_.stats_hz);
   auto next_publish = Clock::now();

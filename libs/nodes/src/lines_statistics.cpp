@@ -1,7 +1,7 @@
 #include "evldt/nodes/lines_statistics.hpp"
 
-#include <algorithm>
 #include <spdlog/spdlog.h>
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -65,11 +65,13 @@ void LinesStatistics::publish(const LinesNodeTotals& now, const LatencySummary& 
 }
 
 void LinesStatistics::log(const LinesNodeTotals& now) const {
-  spdlog::info("{} events stored, {} batches ({} lost, {} shed over the latency budget, {} invalid messages), "
-               "{} lines created, {} lists published, latency {:.1f} / {:.1f} ms (median / p99 of the last "
-               "statistics period)",
-               now.events_stored, now.receiver.sequence.received, now.receiver.sequence.lost, now.receiver.batches_shed,
-               now.receiver.invalid_messages, now.lines_created, now.lists_published, last_latency_.median_ms, last_latency_.p99_ms);
+  spdlog::info(
+      "{} events stored, {} batches ({} lost, {} shed over the latency budget, {} invalid messages), "
+      "{} lines created, {} lists published, latency {:.1f} / {:.1f} ms (median / p99 of the last "
+      "statistics period)",
+      now.events_stored, now.receiver.sequence.received, now.receiver.sequence.lost, now.receiver.batches_shed,
+      now.receiver.invalid_messages, now.lines_created, now.lists_published, last_latency_.median_ms,
+      last_latency_.p99_ms);
 }
 
 }  // namespace evldt

@@ -1,11 +1,11 @@
 #include "evldt/nodes/viz_node.hpp"
 
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
 #include <algorithm>
 #include <bit>
 #include <chrono>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
-#include <fmt/core.h>
 #include <stdexcept>
 
 #include "evldt/render/status_text.hpp"
@@ -16,8 +16,9 @@ namespace evldt {
 void VizTotals::print(std::FILE* out, int video_frames, int png_frames) const {
   fmt::print(out, "evldt-viz summary\n");
   fmt::print(out, "  frames    {} drawn, {} in the video, {} PNG snapshots\n", frames, video_frames, png_frames);
-  fmt::print(out, "  received  {} batches ({} lost, {} invalid), {} segment lists ({} invalid), {} stats\n", events.sequence.received,
-             events.sequence.lost, events.invalid_messages, segment_lists, invalid_segment_lists, stats);
+  fmt::print(out, "  received  {} batches ({} lost, {} invalid), {} segment lists ({} invalid), {} stats\n",
+             events.sequence.received, events.sequence.lost, events.invalid_messages, segment_lists,
+             invalid_segment_lists, stats);
 }
 namespace {
 
@@ -31,7 +32,8 @@ VizNode::VizNode(lcm::LCM& lcm, VizNodeOptions options)
     : lcm_(lcm), options_(std::move(options)), receiver_(options_.sensor, options_.time_slack_us, [](SensorSize size) {
         return LatticeGeometry::fits(size, default_config_for(size).lattice.block_size);
       }) {
-  if (!(options_.render_hz > 0 && options_.render_hz <= 1000)) throw std::invalid_argument("render rate must be in (0, 1000] Hz");
+  if (!(options_.render_hz > 0 && options_.render_hz <= 1000))
+    throw std::invalid_argument("render rate must be in (0, 1000] Hz");
   if (!lcm_.good()) throw std::runtime_error("LCM is not initialised (bad URL or no multicast route?)");
   subscriptions_.push_back(lcm_.subscribe(events_channel(options_.camera), &VizNode::on_events, this));
   // Drawing and encoding a frame takes milliseconds: queue the batches meanwhile (LCM's default is 30).
@@ -53,7 +55,8 @@ void VizNode::on_events(const lcm::ReceiveBuffer* buffer, const std::string&) {
     const LatticeParams params = default_config_for(*receiver_.sensor()).lattice;
     lattice_.emplace(params.sensor, params.block_size, params.alpha, /*keep_surface=*/true);
   }
-  if (!first_event_us_ || receiver_.restarted()) first_event_us_ = batch_.empty() ? std::optional<Timestamp>() : batch_.t.front();
+  if (!first_event_us_ || receiver_.restarted())
+    first_event_us_ = batch_.empty() ? std::optional<Timestamp>() : batch_.t.front();
   for (std::size_t i = 0; i < batch_.size(); ++i) lattice_->insert(batch_.x[i], batch_.y[i]);
   events_since_frame_ += batch_.size();
 }
@@ -108,10 +111,12 @@ void VizNode::update_status() {
   status_.clear();
   // Time is since the first event seen (a real recording's clock is its epoch).
   const double since_first_s = first_event_us_ ? static_cast<double>(lines_t_us_ - *first_event_us_) * 1e-6 : 0.0;
-  status_.push_back({options_.camera, fmt::format("t={:.3f} s", std::max(0.0, since_first_s)), fmt::format("{:.2f} Mev/s", event_rate_ * 1e-6),
-                     fmt::format("{} lines", lines_.size()), fmt::format("{} whole", whole_lines_.size())});
+  status_.push_back({options_.camera, fmt::format("t={:.3f} s", std::max(0.0, since_first_s)),
+                     fmt::format("{:.2f} Mev/s", event_rate_ * 1e-6), fmt::format("{} lines", lines_.size()),
+                     fmt::format("{} whole", whole_lines_.size())});
   if (stats_) {
-    status_.push_back({fmt::format("detect {:.0f} Hz", stats_->detect_hz), fmt::format("track {:.0f} Hz", stats_->track_hz),
+    status_.push_back({fmt::format("detect {:.0f} Hz", stats_->detect_hz),
+                       fmt::format("track {:.0f} Hz", stats_->track_hz),
                        fmt::format("latency {:.1f}/{:.1f} ms{}", stats_->latency_median_ms, stats_->latency_p99_ms,
                                    stats_->latency_from_receipt ? " from receipt" : ""),
                        fmt::format("lost {}", stats_->batches_lost), fmt::format("shed {}", stats_->batches_shed),
@@ -120,11 +125,13 @@ void VizNode::update_status() {
     status_.push_back({"no statistics from evldt-lines yet"});
   }
   if (camera_stats_ && camera_stats_->sensor_lag_samples > 0) {
-    status_.push_back({fmt::format("camera: sensor lag {:.1f}/{:.1f} ms", camera_stats_->sensor_lag_median_ms, camera_stats_->sensor_lag_p99_ms)});
+    status_.push_back({fmt::format("camera: sensor lag {:.1f}/{:.1f} ms", camera_stats_->sensor_lag_median_ms,
+                                   camera_stats_->sensor_lag_p99_ms)});
   }
   const ReceiverCounts counts = receiver_.counts();
   if (counts.sequence.lost || counts.invalid_messages) {
-    status_.push_back({fmt::format("viz: {} batches lost", counts.sequence.lost), fmt::format("{} invalid", counts.invalid_messages)});
+    status_.push_back({fmt::format("viz: {} batches lost", counts.sequence.lost),
+                       fmt::format("{} invalid", counts.invalid_messages)});
   }
 }
 
@@ -138,7 +145,8 @@ bool VizNode::handle_pending(Clock::time_point deadline) {
 }
 
 void VizNode::run(const std::atomic<bool>& stop, const FrameHandler& on_frame) {
-  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / options_.render_hz));
+  const auto period =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / options_.render_hz));
   auto next_frame = Clock::now() + period;
   auto last_rate = Clock::now();
   cv::Mat canvas;

@@ -26,7 +26,8 @@ RealtimeEngine::RealtimeEngine(const PipelineConfig& config)
       pool_(config.threads),
       detector_(lattice_.geometry(), config.score, &pool_),
       tracker_(lattice_.geometry(), config.score, config.track, &pool_) {
-  if (config.schedule.shedding_period_factor < 1) throw std::invalid_argument("shedding_period_factor must be at least 1");
+  if (config.schedule.shedding_period_factor < 1)
+    throw std::invalid_argument("shedding_period_factor must be at least 1");
   if (config.schedule.input_pause_ms < 1) throw std::invalid_argument("input_pause_ms must be at least 1");
 }
 
@@ -82,7 +83,8 @@ void RealtimeEngine::process(const EventBatch& input, int copies) {
     {
       std::lock_guard lock(lattice_mutex_);
       if (end > begin) {
-        lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin), copies);
+        lattice_.insert(std::span(batch.x).subspan(begin, end - begin), std::span(batch.y).subspan(begin, end - begin),
+                        copies);
         events_stored_ += end - begin;
         latest_event_us_ = std::max(latest_event_us_, batch.t[end - 1]);
       }
@@ -134,8 +136,8 @@ void RealtimeEngine::note_input(const EventBatch& input) {
 }
 
 template <typename Round>
-void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
-                          Round round) {
+void RealtimeEngine::loop(const char* thread_name, LoopState& state, std::atomic<std::uint64_t>& rounds,
+                          Timestamp period_us, Round round) {
   name_this_thread(thread_name);
   run_this_thread_as_round();
   const auto input_pause = std::chrono::milliseconds(config_.schedule.input_pause_ms);

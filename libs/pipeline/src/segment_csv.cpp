@@ -27,7 +27,8 @@ void SegmentCsvWriter::write_step(Timestamp t, std::span<const TrackedLine> line
     };
     put(t);
     put(line->id);
-    for (const float coordinate : {s.q0.x(), s.q0.y(), s.q1.x(), s.q1.y()}) put(static_cast<double>(coordinate), std::chars_format::fixed, 3);
+    for (const float coordinate : {s.q0.x(), s.q0.y(), s.q1.x(), s.q1.y()})
+      put(static_cast<double>(coordinate), std::chars_format::fixed, 3);
     put(static_cast<double>(line->score), std::chars_format::fixed, 4);
     const std::string_view status = status_name(line->status);
     at = std::copy(status.begin(), status.end(), at);
@@ -61,14 +62,15 @@ std::vector<SegmentRow> read_segment_csv(const std::filesystem::path& path) {
     float x0, y0, x1, y1;
     std::string status;
     const bool with_velocity = header == 0;
-    if (!(fields >> row.t_us >> c[0] >> row.id >> c[1] >> x0 >> c[2] >> y0 >> c[3] >> x1 >> c[4] >> y1 >> c[5] >> row.score >>
-          c[6]) ||
+    if (!(fields >> row.t_us >> c[0] >> row.id >> c[1] >> x0 >> c[2] >> y0 >> c[3] >> x1 >> c[4] >> y1 >> c[5] >>
+          row.score >> c[6]) ||
         std::count(c, c + 7, ',') != 7 || !std::getline(fields, status, with_velocity ? ',' : '\n')) {
       throw std::invalid_argument("malformed row '" + line + "'");
     }
     if (with_velocity) {
       char comma = 0;
-      if (!(fields >> row.normal_velocity >> comma >> row.normal_velocity_std) || comma != ',' || !(fields >> std::ws).eof()) {
+      if (!(fields >> row.normal_velocity >> comma >> row.normal_velocity_std) || comma != ',' ||
+          !(fields >> std::ws).eof()) {
         throw std::invalid_argument("malformed row '" + line + "'");
       }
     }

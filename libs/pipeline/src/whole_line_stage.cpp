@@ -5,7 +5,8 @@ namespace evldt {
 WholeLineStage::WholeLineStage(const PipelineConfig& config, std::uint64_t first_id)
     : tracker_(config.lattice.block_size, config.whole_lines, first_id) {}
 
-std::span<const TrackedLine> WholeLineStage::step(Timestamp t, std::span<const TrackedLine> segments, const ScarfLattice* lattice) {
+std::span<const TrackedLine> WholeLineStage::step(Timestamp t, std::span<const TrackedLine> segments,
+                                                  const ScarfLattice* lattice) {
   tracker_.update(t, segments, lattice);
   lines_.clear();
   for (const WholeLine& line : tracker_.lines()) {

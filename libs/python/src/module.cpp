@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "evldt/app/pipeline_options.hpp"
-#include "evldt/client/line_subscriber.hpp"
 #include "evldt/app/simulator_options.hpp"
+#include "evldt/client/line_subscriber.hpp"
 #include "evldt/eval/evaluation_report.hpp"
 #include "evldt/eval/scene_evaluation.hpp"
 #include "evldt/events/event_validator.hpp"
@@ -200,7 +200,8 @@ class Pipeline {
       throw py::value_error("t, x, y and p must be one-dimensional");
     }
     const py::ssize_t n = t.shape(0);
-    if (x.shape(0) != n || y.shape(0) != n || p.shape(0) != n) throw py::value_error("t, x, y and p must have one length");
+    if (x.shape(0) != n || y.shape(0) != n || p.shape(0) != n)
+      throw py::value_error("t, x, y and p must have one length");
     const auto ts = t.unchecked<1>();
     const auto xs = x.unchecked<1>();
     const auto ys = y.unchecked<1>();
@@ -274,16 +275,16 @@ class Pipeline {
 
 /// evldt-eval's figures of predicted segments against ground truth.
 py::object evaluate(const py::array_t<SegmentRecord>& segments, const py::array_t<GroundTruthRecord>& ground_truth,
-                  int width, int height, const std::vector<double>& tolerances, Timestamp output_period_us,
-                  std::optional<float> min_normal_speed) {
+                    int width, int height, const std::vector<double>& tolerances, Timestamp output_period_us,
+                    std::optional<float> min_normal_speed) {
   if (min_normal_speed && !(*min_normal_speed >= 0)) throw py::value_error("min_normal_speed must not be negative");
   std::vector<SegmentRow> rows;
   const auto predicted = segments.unchecked<1>();
   rows.reserve(static_cast<std::size_t>(predicted.shape(0)));
   for (py::ssize_t i = 0; i < predicted.shape(0); ++i) {
     const SegmentRecord& r = predicted(i);
-    rows.push_back({r.t, r.id, Segment{Point2(r.x0, r.y0), Point2(r.x1, r.y1)}, r.score, static_cast<LineStatus>(r.status),
-                    r.normal_velocity, r.normal_velocity_std});
+    rows.push_back({r.t, r.id, Segment{Point2(r.x0, r.y0), Point2(r.x1, r.y1)}, r.score,
+                    static_cast<LineStatus>(r.status), r.normal_velocity, r.normal_velocity_std});
   }
   std::vector<GroundTruthRow> truth_rows;
   const auto truth = ground_truth.unchecked<1>();
@@ -298,10 +299,9 @@ py::object evaluate(const py::array_t<SegmentRecord>& segments, const py::array_
   {
     py::gil_scoped_release unlocked;
     GroundTruthSteps steps = csv_ground_truth_steps(truth_rows);
-    evaluator.emplace(evaluate_segment_rows(std::move(rows), std::move(steps), SensorSize{width, height}, tolerances,
-                                            output_period_us,
-                                            min_normal_speed ? std::optional<VisibleOnly>(VisibleOnly::by_speed(*min_normal_speed))
-                                                             : std::nullopt));
+    evaluator.emplace(evaluate_segment_rows(
+        std::move(rows), std::move(steps), SensorSize{width, height}, tolerances, output_period_us,
+        min_normal_speed ? std::optional<VisibleOnly>(VisibleOnly::by_speed(*min_normal_speed)) : std::nullopt));
   }
   // evldt-eval's figures under its JSON keys (a run of its --json without the run's own fields).
   return py::module_::import("json").attr("loads")(evaluation_json(make_evaluation_report(*evaluator)));
@@ -364,8 +364,18 @@ class Subscriber {
     auto out = lines.mutable_unchecked<1>();
     for (std::size_t i = 0; i < list.lines.size(); ++i) {
       const client::Line& l = list.lines[i];
-      out(static_cast<py::ssize_t>(i)) = {list.t_us, static_cast<std::uint64_t>(l.id), l.x0, l.y0, l.x1, l.y1, l.score,
-                                          static_cast<std::uint8_t>(l.status), 0, 0, l.normal_velocity, l.normal_velocity_std};
+      out(static_cast<py::ssize_t>(i)) = {list.t_us,
+                                          static_cast<std::uint64_t>(l.id),
+                                          l.x0,
+                                          l.y0,
+                                          l.x1,
+                                          l.y1,
+                                          l.score,
+                                          static_cast<std::uint8_t>(l.status),
+                                          0,
+                                          0,
+                                          l.normal_velocity,
+                                          l.normal_velocity_std};
     }
     return py::make_tuple(list.whole_lines, list.camera, list.t_us, lines);
   }

@@ -13,8 +13,9 @@ namespace {
 // Continuous coordinates -> OpenCV pixel-centre coordinates, drawn with 4 fractional bits.
 constexpr int kShift = 4;
 cv::Point to_canvas(const Point2& p, int scale) {
-  return cv::Point(static_cast<int>(std::lround(p.x() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)),
-                   static_cast<int>(std::lround(p.y() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)));
+  return cv::Point(
+      static_cast<int>(std::lround(p.x() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)),
+      static_cast<int>(std::lround(p.y() * static_cast<float>(scale * (1 << kShift)) - (1 << kShift) / 2.0f)));
 }
 
 void draw_labelled(cv::Mat& canvas, const TrackedLine& line, const cv::Scalar& colour, int thickness, int scale,
@@ -24,7 +25,8 @@ void draw_labelled(cv::Mat& canvas, const TrackedLine& line, const cv::Scalar& c
   if (!show_label) return;
   const Point2 c = line.segment.centre();
   cv::putText(canvas, std::to_string(label),
-              cv::Point(static_cast<int>(c.x() * static_cast<float>(scale)) + 3, static_cast<int>(c.y() * static_cast<float>(scale))),
+              cv::Point(static_cast<int>(c.x() * static_cast<float>(scale)) + 3,
+                        static_cast<int>(c.y() * static_cast<float>(scale))),
               cv::FONT_HERSHEY_PLAIN, 0.8, colour, 1, cv::LINE_AA);
 }
 
@@ -32,9 +34,12 @@ void draw_labelled(cv::Mat& canvas, const TrackedLine& line, const cv::Scalar& c
 
 cv::Scalar status_colour(LineStatus status) {
   switch (status) {
-    case LineStatus::Detected: return {0, 220, 255};   // yellow
-    case LineStatus::GoodTrack: return {80, 220, 60};  // green
-    case LineStatus::BadTrack: return {40, 40, 230};   // red
+    case LineStatus::Detected:
+      return {0, 220, 255};  // yellow
+    case LineStatus::GoodTrack:
+      return {80, 220, 60};  // green
+    case LineStatus::BadTrack:
+      return {40, 40, 230};  // red
   }
   return {255, 255, 255};
 }
@@ -54,7 +59,8 @@ bool toggle_layer(RenderOptions& options, int key) {
 std::vector<std::string> layer_key_help() {
   std::vector<std::string> fields;
   fields.reserve(std::size(kLayers) + 1);
-  for (const Layer& layer : kLayers) fields.push_back(std::string(fields.empty() ? "keys: " : "") + layer.key + " " + layer.name);
+  for (const Layer& layer : kLayers)
+    fields.push_back(std::string(fields.empty() ? "keys: " : "") + layer.key + " " + layer.name);
   fields.emplace_back("q quit");
   return fields;
 }
@@ -80,15 +86,18 @@ void render_scene(SensorSize sensor, std::span<const std::uint16_t> surface, std
     // Block borders lie on the lattice lines b/2 + k b (scarf_lattice.hpp).
     const cv::Scalar grid(90, 60, 40);
     const int b = options.grid_block_size, half = b / 2;
-    for (int x = half; x <= sensor.width; x += b) cv::line(canvas, {x * scale, 0}, {x * scale, canvas.rows - 1}, grid, 1);
-    for (int y = half; y <= sensor.height; y += b) cv::line(canvas, {0, y * scale}, {canvas.cols - 1, y * scale}, grid, 1);
+    for (int x = half; x <= sensor.width; x += b)
+      cv::line(canvas, {x * scale, 0}, {x * scale, canvas.rows - 1}, grid, 1);
+    for (int y = half; y <= sensor.height; y += b)
+      cv::line(canvas, {0, y * scale}, {canvas.cols - 1, y * scale}, grid, 1);
   }
   const int thickness = std::max(1, scale / 2);
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const TrackedLine& line = lines[i];
     const bool bad = line.status == LineStatus::BadTrack;
     if (bad ? !options.show_bad_tracks : !options.show_segments) continue;
-    draw_labelled(canvas, line, status_colour(line.status), thickness, scale, options.show_segment_ids, i < labels.size() ? labels[i] : line.id);
+    draw_labelled(canvas, line, status_colour(line.status), thickness, scale, options.show_segment_ids,
+                  i < labels.size() ? labels[i] : line.id);
   }
 }
 
@@ -108,11 +117,14 @@ void draw_whole_lines(std::span<const TrackedLine> lines, const RenderOptions& o
   const int scale = std::max(1, options.scale);
   const cv::Scalar cyan(230, 210, 40), orange(0, 140, 255);
   for (std::size_t i = 0; i < lines.size(); ++i) {
-    draw_labelled(canvas, lines[i], cyan, std::max(2, scale), scale, options.show_whole_line_ids, i < labels.size() ? labels[i] : lines[i].id);
+    draw_labelled(canvas, lines[i], cyan, std::max(2, scale), scale, options.show_whole_line_ids,
+                  i < labels.size() ? labels[i] : lines[i].id);
     if (!options.show_motion) continue;
     const Segment arrow = motion_arrow(lines[i].segment, lines[i].normal_velocity);
     if (!((arrow.q1 - arrow.q0).norm() >= 1.0f)) continue;  // still, or not known
-    const auto at = [&](Point2 p) { return cv::Point2f(p.x() * static_cast<float>(scale), p.y() * static_cast<float>(scale)); };
+    const auto at = [&](Point2 p) {
+      return cv::Point2f(p.x() * static_cast<float>(scale), p.y() * static_cast<float>(scale));
+    };
     cv::arrowedLine(canvas, at(arrow.q0), at(arrow.q1), orange, std::max(1, scale / 2), cv::LINE_AA, 0, 0.3);
   }
 }

@@ -7,9 +7,9 @@ namespace {
 
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kFontScale = 0.45;
-constexpr int kOutline = 3;      // px: the dark outline drawn under the white text
-constexpr int kLeft = 6;         // px from the picture's left edge
-constexpr int kRowHeight = 18;   // px
+constexpr int kOutline = 3;     // px: the dark outline drawn under the white text
+constexpr int kLeft = 6;        // px from the picture's left edge
+constexpr int kRowHeight = 18;  // px
 
 int text_width(const std::string& text) {
   int baseline = 0;

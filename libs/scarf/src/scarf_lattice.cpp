@@ -42,7 +42,8 @@ LatticeGeometry LatticeGeometry::make(SensorSize sensor, int block_size, double 
                                 std::to_string(sensor.width) + "x" + std::to_string(sensor.height) + " sensor");
   }
   if (capacity < 3 || capacity > 65535) {
-    throw std::invalid_argument("alpha * b * b / 2 = " + std::to_string(capacity) + " entries per block is outside 3..65535");
+    throw std::invalid_argument("alpha * b * b / 2 = " + std::to_string(capacity) +
+                                " entries per block is outside 3..65535");
   }
   g.capacity = static_cast<int>(capacity);
   return g;
@@ -58,7 +59,8 @@ int LatticeGeometry::block_at(float x, float y) const {
   return index(i, j);
 }
 
-std::vector<ScarfLattice::AxisBlocks> ScarfLattice::axis_blocks(int length, int block_size, int blocks, int stride, int shift) {
+std::vector<ScarfLattice::AxisBlocks> ScarfLattice::axis_blocks(int length, int block_size, int blocks, int stride,
+                                                                int shift) {
   std::vector<AxisBlocks> table(static_cast<std::size_t>(length));
   const int half = block_size / 2;
   for (int p = 0; p < length; ++p) {
@@ -114,7 +116,9 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
   const bool same_source = copied_from_ == other.versions_of();
   const std::size_t capacity = static_cast<std::size_t>(geometry_.capacity);
   const std::size_t count = blocks_.size();
-  const auto changed = [&](std::size_t block) { return !same_source || blocks_[block].version != other.blocks_[block].version; };
+  const auto changed = [&](std::size_t block) {
+    return !same_source || blocks_[block].version != other.blocks_[block].version;
+  };
   // Runs of changed blocks are copied with one memcpy each: where most blocks changed this is a
   // plain copy of the lattice, where few did it touches only those.
   for (std::size_t begin = 0; begin < count;) {
@@ -124,9 +128,11 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
     }
     std::size_t end = begin + 1;
     while (end < count && changed(end)) ++end;
-    std::copy(other.blocks_.begin() + static_cast<std::ptrdiff_t>(begin), other.blocks_.begin() + static_cast<std::ptrdiff_t>(end),
+    std::copy(other.blocks_.begin() + static_cast<std::ptrdiff_t>(begin),
+              other.blocks_.begin() + static_cast<std::ptrdiff_t>(end),
               blocks_.begin() + static_cast<std::ptrdiff_t>(begin));
-    std::copy(other.arrivals_.begin() + static_cast<std::ptrdiff_t>(begin), other.arrivals_.begin() + static_cast<std::ptrdiff_t>(end),
+    std::copy(other.arrivals_.begin() + static_cast<std::ptrdiff_t>(begin),
+              other.arrivals_.begin() + static_cast<std::ptrdiff_t>(end),
               arrivals_.begin() + static_cast<std::ptrdiff_t>(begin));
     std::copy(other.entries_.begin() + static_cast<std::ptrdiff_t>(begin * capacity),
               other.entries_.begin() + static_cast<std::ptrdiff_t>(end * capacity),
@@ -139,8 +145,8 @@ void ScarfLattice::copy_state_from(const ScarfLattice& other) {
 }
 
 std::size_t ScarfLattice::memory_bytes() const {
-  return entries_.size() * sizeof(LatticeEntry) + blocks_.size() * sizeof(BlockState) + arrivals_.size() * sizeof(std::uint16_t) +
-         (columns_.size() + rows_.size()) * sizeof(AxisBlocks) +
+  return entries_.size() * sizeof(LatticeEntry) + blocks_.size() * sizeof(BlockState) +
+         arrivals_.size() * sizeof(std::uint16_t) + (columns_.size() + rows_.size()) * sizeof(AxisBlocks) +
          surface_.size() * sizeof(std::uint16_t);
 }
 

@@ -12,7 +12,9 @@ namespace {
 
 // Linear intensity -> log intensity, with a floor so black is finite (as a real pixel's dark current).
 constexpr double kDarkCurrent = 0.02;
-float log_intensity(double brightness) { return static_cast<float>(std::log(std::max(brightness, 0.0) + kDarkCurrent)); }
+float log_intensity(double brightness) {
+  return static_cast<float>(std::log(std::max(brightness, 0.0) + kDarkCurrent));
+}
 
 // Pixels whose centre (x + 0.5, y + 0.5) is inside the convex polygon get `value`.
 void fill_convex(const std::vector<Vec2d>& polygon, float value, int width, int height, std::vector<float>& image) {
@@ -38,15 +40,20 @@ void fill_convex(const std::vector<Vec2d>& polygon, float value, int width, int 
     if (left >= right) continue;
     const int x_first = std::max(0, static_cast<int>(std::ceil(left - 0.5)));
     const int x_end = std::min(width, static_cast<int>(std::ceil(right - 0.5)));
-    if (x_first < x_end) std::fill(image.begin() + static_cast<std::ptrdiff_t>(y) * width + x_first,
-                                   image.begin() + static_cast<std::ptrdiff_t>(y) * width + x_end, value);
+    if (x_first < x_end)
+      std::fill(image.begin() + static_cast<std::ptrdiff_t>(y) * width + x_first,
+                image.begin() + static_cast<std::ptrdiff_t>(y) * width + x_end, value);
   }
 }
 
 }  // namespace
 
 EventSimulator::EventSimulator(Scene scene, const SimulatorConfig& config)
-    : scene_(std::move(scene)), config_(config), random_(config.seed), width_(scene_.sensor.width), height_(scene_.sensor.height) {
+    : scene_(std::move(scene)),
+      config_(config),
+      random_(config.seed),
+      width_(scene_.sensor.width),
+      height_(scene_.sensor.height) {
   if (!scene_.sensor.valid()) throw std::invalid_argument("scene has no sensor size");
   if (config.lens && config.lens->size() != 2 * static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_)) {
     throw std::invalid_argument("the lens does not match the scene's sensor size");
@@ -58,8 +65,10 @@ EventSimulator::EventSimulator(Scene scene, const SimulatorConfig& config)
   threshold_on_.resize(pixels);
   threshold_off_.resize(pixels);
   for (std::size_t i = 0; i < pixels; ++i) {
-    threshold_on_[i] = static_cast<float>(std::max(0.02, config.contrast_on + config.contrast_sigma * random_.normal()));
-    threshold_off_[i] = static_cast<float>(std::max(0.02, config.contrast_off + config.contrast_sigma * random_.normal()));
+    threshold_on_[i] =
+        static_cast<float>(std::max(0.02, config.contrast_on + config.contrast_sigma * random_.normal()));
+    threshold_off_[i] =
+        static_cast<float>(std::max(0.02, config.contrast_off + config.contrast_sigma * random_.normal()));
   }
   for (int i = 0; i < config.hot_pixels; ++i) hot_pixels_.push_back(static_cast<std::uint32_t>(random_.below(pixels)));
   last_event_.assign(pixels, -config.refractory_us - 1);
@@ -81,7 +90,8 @@ void EventSimulator::render(Timestamp t_us, std::vector<float>& log_image) const
   std::fill(canvas.begin(), canvas.end(), background);
   for (std::size_t k = 0; k < scene_.shapes.size(); ++k) {
     const Shape& shape = scene_.shapes[k];
-    fill_convex(scene_.polygon_at(k, t), log_intensity(shape.brightness * shape.flicker.factor_at(t_us)), width_, height_, canvas);
+    fill_convex(scene_.polygon_at(k, t), log_intensity(shape.brightness * shape.flicker.factor_at(t_us)), width_,
+                height_, canvas);
   }
   if (!config_.lens) return;
   // Each sensor pixel sees the rectified scene where its centre looks: bilinear between the four
@@ -89,12 +99,15 @@ void EventSimulator::render(Timestamp t_us, std::vector<float>& log_image) const
   const std::vector<float>& looks = *config_.lens;
   for (std::size_t i = 0; i < log_image.size(); ++i) {
     const float u = looks[2 * i] - 0.5f, v = looks[2 * i + 1] - 0.5f;
-    if (!(u >= -0.5f && v >= -0.5f && u <= static_cast<float>(width_) - 0.5f && v <= static_cast<float>(height_) - 0.5f)) {
+    if (!(u >= -0.5f && v >= -0.5f && u <= static_cast<float>(width_) - 0.5f &&
+          v <= static_cast<float>(height_) - 0.5f)) {
       log_image[i] = background;
       continue;
     }
-    const int x0 = std::clamp(static_cast<int>(std::floor(u)), 0, width_ - 2), y0 = std::clamp(static_cast<int>(std::floor(v)), 0, height_ - 2);
-    const float ax = std::clamp(u - static_cast<float>(x0), 0.0f, 1.0f), ay = std::clamp(v - static_cast<float>(y0), 0.0f, 1.0f);
+    const int x0 = std::clamp(static_cast<int>(std::floor(u)), 0, width_ - 2),
+              y0 = std::clamp(static_cast<int>(std::floor(v)), 0, height_ - 2);
+    const float ax = std::clamp(u - static_cast<float>(x0), 0.0f, 1.0f),
+                ay = std::clamp(v - static_cast<float>(y0), 0.0f, 1.0f);
     const float* row = canvas.data() + static_cast<std::size_t>(y0) * static_cast<std::size_t>(width_) + x0;
     // Weighted sums, so that a look at a pixel's centre takes its value exactly (a pinhole lens
     // gives the pinhole's events).
@@ -111,7 +124,8 @@ void EventSimulator::render_frame(Timestamp t_us, std::vector<std::uint8_t>& gre
   // The exposure as the mean of instants across it, one per 250 us (at least 1, at most 32).
   const int instants = aps.exposure_us <= 0 ? 1 : static_cast<int>(std::clamp<Timestamp>(aps.exposure_us / 250, 2, 32));
   for (int k = 0; k < instants; ++k) {
-    const Timestamp at = instants == 1 ? t_us : t_us - aps.exposure_us / 2 + aps.exposure_us * (2 * k + 1) / (2 * instants);
+    const Timestamp at =
+        instants == 1 ? t_us : t_us - aps.exposure_us / 2 + aps.exposure_us * (2 * k + 1) / (2 * instants);
     render(at, log_image);
     for (std::size_t i = 0; i < pixels; ++i) {
       brightness[i] += std::clamp(std::exp(static_cast<double>(log_image[i])) - kDarkCurrent, 0.0, 1.0) / instants;
@@ -143,7 +157,8 @@ Timestamp EventSimulator::next_step() {
       for (std::size_t v = 0; v < a.size(); ++v) largest = std::max(largest, (b[v] - a[v]).norm());
     }
     if (largest <= config_.max_step_px) break;
-    step = std::max<Timestamp>(1, static_cast<Timestamp>(static_cast<double>(step) * config_.max_step_px / largest * 0.95));
+    step = std::max<Timestamp>(
+        1, static_cast<Timestamp>(static_cast<double>(step) * config_.max_step_px / largest * 0.95));
   }
   return rendered_ + step;
 }
@@ -169,7 +184,8 @@ void EventSimulator::emit_signal(Timestamp t0, Timestamp t1) {
       }
       last_event_[i] = t;
       pending_.push_back({t, static_cast<std::uint16_t>(i % static_cast<std::size_t>(width_)),
-                          static_cast<std::uint16_t>(i / static_cast<std::size_t>(width_)), static_cast<std::int8_t>(rising ? 1 : -1)});
+                          static_cast<std::uint16_t>(i / static_cast<std::size_t>(width_)),
+                          static_cast<std::int8_t>(rising ? 1 : -1)});
       ++counters_.signal_events;
     }
     reference += (rising ? 1.0f : -1.0f) * static_cast<float>(crossings) * threshold;
@@ -179,7 +195,8 @@ void EventSimulator::emit_signal(Timestamp t0, Timestamp t1) {
 void EventSimulator::emit_noise(Timestamp t0, Timestamp t1) {
   const double end_s = static_cast<double>(t1) * 1e-6;
   const std::size_t pixels = log_now_.size();
-  const double noise_total = (config_.noise_rate_hz + std::max(0.0, config_.dark_noise_hz)) * static_cast<double>(pixels);
+  const double noise_total =
+      (config_.noise_rate_hz + std::max(0.0, config_.dark_noise_hz)) * static_cast<double>(pixels);
   auto fire = [&](double time_s, std::size_t pixel) {
     const Timestamp t = std::clamp<Timestamp>(static_cast<Timestamp>(std::ceil(time_s * 1e6)), t0 + 1, t1);
     pending_.push_back({t, static_cast<std::uint16_t>(pixel % static_cast<std::size_t>(width_)),
@@ -212,9 +229,10 @@ void EventSimulator::read_out(std::size_t first) {
   std::size_t kept = first;
   for (std::size_t i = first; i < pending_.size(); ++i) {
     Event e = pending_[i];
-    const Timestamp jitter = config_.timestamp_jitter_us > 0 ? static_cast<Timestamp>(random_.below(
-                                                                   static_cast<std::size_t>(config_.timestamp_jitter_us) + 1))
-                                                             : 0;
+    const Timestamp jitter =
+        config_.timestamp_jitter_us > 0
+            ? static_cast<Timestamp>(random_.below(static_cast<std::size_t>(config_.timestamp_jitter_us) + 1))
+            : 0;
     const double leaves_us = std::max(static_cast<double>(e.t + jitter), readout_free_us_);
     if (spacing_us > 0 && leaves_us - static_cast<double>(e.t) > static_cast<double>(config_.readout_queue_us)) {
       ++counters_.readout_losses;
@@ -247,7 +265,8 @@ bool EventSimulator::run_until(Timestamp until_us, EventBatch& out) {
     rendered_ = t1;
     ++counters_.sub_frames;
   }
-  while (pending_head_ < pending_.size() && pending_[pending_head_].t <= limit) out.push_back(pending_[pending_head_++]);
+  while (pending_head_ < pending_.size() && pending_[pending_head_].t <= limit)
+    out.push_back(pending_[pending_head_++]);
   now_ = std::max(now_, limit);
   return out.size() > before || now_ < scene_.duration_us;
 }

@@ -9,7 +9,8 @@ namespace evldt {
 
 void GroundTruthCsvWriter::write_step(Timestamp t, std::span<const GtSegment> segments) {
   for (const GtSegment& s : segments) {
-    std::fprintf(output_.file(), "%" PRId64 ",%d,%.3f,%.3f,%.3f,%.3f\n", t, s.gt_id, s.a.x(), s.a.y(), s.b.x(), s.b.y());
+    std::fprintf(output_.file(), "%" PRId64 ",%d,%.3f,%.3f,%.3f,%.3f\n", t, s.gt_id, s.a.x(), s.a.y(), s.b.x(),
+                 s.b.y());
   }
 }
 

@@ -80,15 +80,17 @@ Interval inside_convex(const Vec2d& a, const Vec2d& b, const std::vector<Vec2d>&
     const Vec2d& p = polygon[i];
     const Vec2d edge = polygon[(i + 1) % polygon.size()] - p;
     const Vec2d inward = orientation * Vec2d(-edge.y(), edge.x());  // points into the polygon
-    const double num = inward.dot(a - p);  // >= 0 inside this half-plane at u = 0
+    const double num = inward.dot(a - p);                           // >= 0 inside this half-plane at u = 0
     const double den = inward.dot(d);
     if (std::abs(den) < 1e-12) {
       if (num < 0) return {1.0, 0.0};
       continue;
     }
     const double u = -num / den;
-    if (den > 0) lo = std::max(lo, u);
-    else hi = std::min(hi, u);
+    if (den > 0)
+      lo = std::max(lo, u);
+    else
+      hi = std::min(hi, u);
   }
   return {lo, hi};
 }
@@ -99,7 +101,8 @@ std::vector<GtSegment> Scene::visible_edges(Timestamp t_us, double min_length_px
   const double t = static_cast<double>(t_us) * 1e-6;
   std::vector<std::vector<Vec2d>> polygons;
   for (std::size_t k = 0; k < shapes.size(); ++k) polygons.push_back(polygon_at(k, t));
-  const std::vector<Vec2d> frame{{0, 0}, {static_cast<double>(sensor.width), 0},
+  const std::vector<Vec2d> frame{{0, 0},
+                                 {static_cast<double>(sensor.width), 0},
                                  {static_cast<double>(sensor.width), static_cast<double>(sensor.height)},
                                  {0, static_cast<double>(sensor.height)}};
   std::vector<GtSegment> out;

@@ -12,7 +12,9 @@ namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
 
-std::vector<Vec2d> rectangle(double x0, double y0, double x1, double y1) { return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}; }
+std::vector<Vec2d> rectangle(double x0, double y0, double x1, double y1) {
+  return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+}
 
 std::vector<Vec2d> regular_polygon(Vec2d centre, double radius, int sides, double rotation) {
   std::vector<Vec2d> out;
@@ -31,7 +33,9 @@ Shape solid(std::vector<Vec2d> polygon, double brightness, bool straight = true)
   return s;
 }
 
-MotionChannel sine(double amplitude, double frequency_hz, double phase = 0) { return {0, 0, amplitude, frequency_hz, phase}; }
+MotionChannel sine(double amplitude, double frequency_hz, double phase = 0) {
+  return {0, 0, amplitude, frequency_hz, phase};
+}
 
 // Three dark vertical bars taller than the view, swept fast left and right (peak ~940 px/s).
 Scene three_lines_fast() {
@@ -197,7 +201,8 @@ Scene poster_10s() {
 Scene tag_board() {
   Scene s{"tag-board", {346, 260}, 0.3, {}, {}, 10'000'000};
   constexpr double kCell = 8, kMarker = 7 * kCell, kGap = 18, kLeft = 34, kTop = 28;
-  s.shapes.push_back(solid(rectangle(kLeft - 14, kTop - 14, kLeft + 4 * kMarker + 3 * kGap + 14, kTop + 3 * kMarker + 2 * kGap + 14), 0.9));
+  s.shapes.push_back(solid(
+      rectangle(kLeft - 14, kTop - 14, kLeft + 4 * kMarker + 3 * kGap + 14, kTop + 3 * kMarker + 2 * kGap + 14), 0.9));
   // White rectangles (first column, first row, end column, end row) on the inner 5 x 5 cells; two
   // of one marker are at least a cell apart, so every edge is seen whole.
   struct Cells {
@@ -222,9 +227,9 @@ Scene tag_board() {
       const double x = kLeft + col * (kMarker + kGap), y = kTop + row * (kMarker + kGap);
       s.shapes.push_back(solid(rectangle(x, y, x + kMarker, y + kMarker), 0.08));
       for (const Cells& c : patterns[row * 4 + col]) {
-        s.shapes.push_back(solid(rectangle(x + (1 + c.c0) * kCell, y + (1 + c.r0) * kCell, x + (1 + c.c1) * kCell,
-                                           y + (1 + c.r1) * kCell),
-                                 0.9));
+        s.shapes.push_back(solid(
+            rectangle(x + (1 + c.c0) * kCell, y + (1 + c.r0) * kCell, x + (1 + c.c1) * kCell, y + (1 + c.r1) * kCell),
+            0.9));
       }
     }
   }
@@ -241,9 +246,9 @@ Scene tag_board() {
 }  // namespace
 
 const std::vector<std::string>& scene_names() {
-  static const std::vector<std::string> names{"three-lines-fast", "circle-board", "boxes-6dof", "multi-speed", "monitor-hd",
-                                              "noisy-boxes", "flicker-lamps", "night-boxes", "boxes-10s", "poster-10s",
-                                              "tag-board"};
+  static const std::vector<std::string> names{"three-lines-fast", "circle-board", "boxes-6dof",    "multi-speed",
+                                              "monitor-hd",       "noisy-boxes",  "flicker-lamps", "night-boxes",
+                                              "boxes-10s",        "poster-10s",   "tag-board"};
   return names;
 }
 
@@ -286,7 +291,9 @@ Scene make_scene(std::string_view name) {
 Scene vary_camera_motion(Scene scene, std::uint64_t seed) {
   if (seed == 0) return scene;
   SimRandom random(seed);
-  const auto scale = [&random] { return std::exp(std::log(0.8) + random.uniform() * (std::log(1.25) - std::log(0.8))); };
+  const auto scale = [&random] {
+    return std::exp(std::log(0.8) + random.uniform() * (std::log(1.25) - std::log(0.8)));
+  };
   Motion& m = scene.camera;
   for (MotionChannel* channel : {&m.tx, &m.ty, &m.angle, &m.log_scale, &m.perspective_x, &m.perspective_y}) {
     if (channel->amplitude == 0) continue;
@@ -307,7 +314,8 @@ Scene with_occluder(Scene scene, Timestamp hidden_us) {
   const double sweep = std::numbers::pi * kCrossingsPerSecond;  // pi A is the peak speed
   const double hidden_s = static_cast<double>(hidden_us) * 1e-6, w = scene.sensor.width, h = scene.sensor.height;
   if (hidden_s * sweep >= 1) {
-    throw std::invalid_argument("an occlusion of " + std::to_string(hidden_us / 1000) + " ms is longer than a bar sweeping "
+    throw std::invalid_argument("an occlusion of " + std::to_string(hidden_us / 1000) +
+                                " ms is longer than a bar sweeping "
                                 "once a second can hide anything (at most 318 ms)");
   }
   const double width = hidden_s * sweep * (w / 2) / (1 - hidden_s * sweep);
@@ -315,7 +323,9 @@ Scene with_occluder(Scene scene, Timestamp hidden_us) {
   // Tall enough to span the image however the camera moves it.
   bar.polygon = {Vec2d(-width / 2, -h), Vec2d(width / 2, -h), Vec2d(width / 2, 2 * h), Vec2d(-width / 2, 2 * h)};
   bar.brightness = scene.background > 0.5 ? 0.1 : 0.9;
-  bar.motion.tx = {.base = w / 2, .amplitude = w / 2 + width, .frequency_hz = kCrossingsPerSecond / 2,
+  bar.motion.tx = {.base = w / 2,
+                   .amplitude = w / 2 + width,
+                   .frequency_hz = kCrossingsPerSecond / 2,
                    .phase = -std::numbers::pi / 2};
   scene.shapes.push_back(bar);
   scene.name += "/o" + std::to_string(hidden_us / 1000);

@@ -1,21 +1,21 @@
 #include "evldt/sources/event_source.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <charconv>
 #include <chrono>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>  // its constants; the calls go through evldt::media
-#include <bit>
 #include <stdexcept>
 #include <thread>
 
+#include <spdlog/spdlog.h>
 #include "evldt/containers/aedat4.hpp"
 #include "evldt/containers/hdf5_events.hpp"
 #include "evldt/containers/packet_source.hpp"
 #include "evldt/events/event_stream_reader.hpp"
 #include "evldt/frames/frame_reader.hpp"
 #include "evldt/media/media.hpp"
-#include <spdlog/spdlog.h>
 #include "evldt/transport/lcm_log.hpp"
 
 namespace evldt {
@@ -31,7 +31,8 @@ class RecordingSource final : public EventSource {
   [[nodiscard]] DecodeCounts decode_counts() const override { return reader_->counts(); }
   [[nodiscard]] double progress() const override {
     if (live_) return 0.0;
-    return static_cast<double>(reader_->bytes_read()) / static_cast<double>(std::max<std::uint64_t>(1, reader_->total_bytes()));
+    return static_cast<double>(reader_->bytes_read()) /
+           static_cast<double>(std::max<std::uint64_t>(1, reader_->total_bytes()));
   }
   [[nodiscard]] bool live() const override { return live_; }
 
@@ -88,7 +89,8 @@ class ReconnectingSource final : public EventSource {
       } catch (const std::runtime_error& error) {  // no server yet, or a stream that broke in its header
         if (std::has_single_bit(attempt)) spdlog::warn("{} (attempt {}; trying again)", error.what(), attempt);
       }
-      for (auto waited = std::chrono::milliseconds(0); waited < wait && !stop_.load(); waited += std::chrono::milliseconds(50)) {
+      for (auto waited = std::chrono::milliseconds(0); waited < wait && !stop_.load();
+           waited += std::chrono::milliseconds(50)) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
       }
       wait = std::min<std::chrono::milliseconds>(wait * 2, kLongestWait);
@@ -236,8 +238,10 @@ class VideoSource final : public EventSource {
       cv::cvtColor(frame_, grey_, frame_.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
     }
     if (grey_.depth() != CV_8U) grey_.convertTo(grey_, CV_8U);
-    const Timestamp t = live_ ? std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - started_).count()
-                              : video_frame_time_us(frames_, fps_);
+    const Timestamp t =
+        live_
+            ? std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - started_).count()
+            : video_frame_time_us(frames_, fps_);
     // Frame times must increase; a webcam may deliver two frames within a microsecond.
     const Timestamp frame_t = std::max(t, last_t_ + 1);
     last_t_ = frame_t;
@@ -277,7 +281,8 @@ std::unique_ptr<EventSource> open_recording(const std::filesystem::path& path, s
 
 std::unique_ptr<EventSource> open_stream(std::unique_ptr<ByteSource> bytes, std::optional<EventFormat> format,
                                          std::string_view extension) {
-  return std::make_unique<RecordingSource>(std::make_unique<EventStreamReader>(std::move(bytes), format, extension), true);
+  return std::make_unique<RecordingSource>(std::make_unique<EventStreamReader>(std::move(bytes), format, extension),
+                                           true);
 }
 
 std::unique_ptr<EventSource> open_dv_stream(std::unique_ptr<ByteSource> bytes) {
@@ -287,7 +292,8 @@ std::unique_ptr<EventSource> open_dv_stream(std::unique_ptr<ByteSource> bytes) {
   return source;
 }
 
-std::unique_ptr<EventSource> open_reconnecting(std::function<std::unique_ptr<EventSource>()> open, const std::atomic<bool>& stop) {
+std::unique_ptr<EventSource> open_reconnecting(std::function<std::unique_ptr<EventSource>()> open,
+                                               const std::atomic<bool>& stop) {
   return std::make_unique<ReconnectingSource>(std::move(open), stop);
 }
 
@@ -295,6 +301,8 @@ std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& conf
   return std::make_unique<SceneSource>(std::move(scene), config, label);
 }
 
-std::unique_ptr<EventSource> open_video(const VideoSourceOptions& options) { return std::make_unique<VideoSource>(options); }
+std::unique_ptr<EventSource> open_video(const VideoSourceOptions& options) {
+  return std::make_unique<VideoSource>(options);
+}
 
 }  // namespace evldt

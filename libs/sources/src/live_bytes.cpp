@@ -1,25 +1,27 @@
 #include "evldt/sources/live_bytes.hpp"
 
-#include <cerrno>
-#include <cstring>
 #include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
-#include <stdexcept>
 #include <sys/inotify.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
 
 namespace evldt {
 namespace {
 
 constexpr int kStopCheckMs = 100;
 
-std::runtime_error system_error(const std::string& what) { return std::runtime_error(what + ": " + std::strerror(errno)); }
+std::runtime_error system_error(const std::string& what) {
+  return std::runtime_error(what + ": " + std::strerror(errno));
+}
 
 /// Waits until `fd` is readable (true) or `stop` is set (false), without using the CPU.
 bool wait_readable(int fd, const std::atomic<bool>& stop) {
@@ -111,7 +113,8 @@ namespace {
 int connect_unix(const std::string& path) {
   sockaddr_un address{};
   address.sun_family = AF_UNIX;
-  if (path.empty() || path.size() >= sizeof address.sun_path) throw std::runtime_error("'" + path + "' is not a Unix socket path");
+  if (path.empty() || path.size() >= sizeof address.sun_path)
+    throw std::runtime_error("'" + path + "' is not a Unix socket path");
   path.copy(address.sun_path, path.size());
   const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd < 0) throw system_error("socket");
@@ -134,7 +137,7 @@ FollowedFileBytes::FollowedFileBytes(const std::filesystem::path& path, std::chr
   name_ = path.string();
   fd_ = open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) throw system_error("cannot open event file '" + name_ + "'");
-  struct stat info{};
+  struct stat info {};
   if (fstat(fd_, &info) != 0) {
     const std::runtime_error error = system_error("cannot stat '" + name_ + "'");
     close(fd_);  // the destructor does not run for a constructor that throws
@@ -143,7 +146,8 @@ FollowedFileBytes::FollowedFileBytes(const std::filesystem::path& path, std::chr
   device_ = info.st_dev;
   inode_ = info.st_ino;
   watch_fd_ = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
-  if (watch_fd_ < 0 || inotify_add_watch(watch_fd_, path.c_str(), IN_MODIFY | IN_ATTRIB | IN_MOVE_SELF | IN_DELETE_SELF) < 0) {
+  if (watch_fd_ < 0 ||
+      inotify_add_watch(watch_fd_, path.c_str(), IN_MODIFY | IN_ATTRIB | IN_MOVE_SELF | IN_DELETE_SELF) < 0) {
     // Without inotify (limits reached) the wait below still ends every 100 ms: slower, never wrong.
     if (watch_fd_ >= 0) close(watch_fd_);
     watch_fd_ = -1;
@@ -156,14 +160,14 @@ FollowedFileBytes::~FollowedFileBytes() {
 }
 
 void FollowedFileBytes::check_still_the_file() const {
-  struct stat info{};
+  struct stat info {};
   if (stat(path_.c_str(), &info) != 0 || info.st_dev != device_ || info.st_ino != inode_) {
-    throw std::runtime_error("'" + name_ + "' was removed or replaced while it was followed (" + std::to_string(offset_) +
-                             " bytes read)");
+    throw std::runtime_error("'" + name_ + "' was removed or replaced while it was followed (" +
+                             std::to_string(offset_) + " bytes read)");
   }
   if (static_cast<std::uint64_t>(info.st_size) < offset_) {
-    throw std::runtime_error("'" + name_ + "' shrank to " + std::to_string(info.st_size) + " bytes while it was followed (" +
-                             std::to_string(offset_) + " bytes read)");
+    throw std::runtime_error("'" + name_ + "' shrank to " + std::to_string(info.st_size) +
+                             " bytes while it was followed (" + std::to_string(offset_) + " bytes read)");
   }
 }
 
@@ -189,8 +193,9 @@ std::size_t FollowedFileBytes::read(std::span<std::uint8_t> into) {
     } else {
       usleep(kStopCheckMs * 1000);
     }
-    struct stat info{};
-    if (fstat(fd_, &info) == 0 && static_cast<std::uint64_t>(info.st_size) > offset_) last_growth = std::chrono::steady_clock::now();
+    struct stat info {};
+    if (fstat(fd_, &info) == 0 && static_cast<std::uint64_t>(info.st_size) > offset_)
+      last_growth = std::chrono::steady_clock::now();
   }
 }
 

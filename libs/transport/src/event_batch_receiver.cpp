@@ -1,8 +1,8 @@
 #include "evldt/transport/event_batch_receiver.hpp"
 
+#include <spdlog/spdlog.h>
 #include <bit>
 #include <utility>
-#include <spdlog/spdlog.h>
 
 namespace evldt {
 
@@ -84,8 +84,10 @@ bool EventBatchReceiver::admit() {
   if (const std::uint64_t lost = sequence_.counts().lost; std::bit_floor(lost) > before.lost) {
     // Batches the network or this host dropped before they were read (a socket buffer overflowing
     // while the host was busy, most often): the lattice missed their events.
-    spdlog::warn("lost {} event batch(es) in all (sequence gaps; latest before seq {}): is net.core.rmem_max at least "
-                 "8 MiB (deploy/README.md)?", lost, message_.seq);
+    spdlog::warn(
+        "lost {} event batch(es) in all (sequence gaps; latest before seq {}): is net.core.rmem_max at least "
+        "8 MiB (deploy/README.md)?",
+        lost, message_.seq);
   }
   if (!sensor_) sensor_ = size;
   if (!validator_ || restarted_) {

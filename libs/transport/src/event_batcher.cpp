@@ -11,7 +11,8 @@ namespace {
 constexpr std::size_t kMaxSpares = 2;
 }  // namespace
 
-EventBatcher::EventBatcher(Timestamp window_us, std::size_t max_events) : window_us_(window_us), max_events_(max_events) {
+EventBatcher::EventBatcher(Timestamp window_us, std::size_t max_events)
+    : window_us_(window_us), max_events_(max_events) {
   if (window_us < 1 || max_events < 1) throw std::invalid_argument("batch window and size must be at least 1");
 }
 

@@ -52,7 +52,8 @@ LatencyTracker::Included LatencyTracker::list_published(Timestamp lattice_us, st
   // Batches arrive in event-time order, so the included ones are a prefix of the ring.
   while (count_ > 0 && ring_[head_].newest_event_us <= lattice_us) {
     const Pending& batch = ring_[head_];
-    const double latency_ms = static_cast<double>(now_utime - (batch.from_receipt ? batch.received_utime : batch.utime)) * 1e-3;
+    const double latency_ms =
+        static_cast<double>(now_utime - (batch.from_receipt ? batch.received_utime : batch.utime)) * 1e-3;
     from_receipt_ += batch.from_receipt ? 1 : 0;
     statistics_.add(latency_ms);
     if (batch.utime - *first_utime_ >= kSettleUs) settled_.add(latency_ms);

@@ -1,8 +1,8 @@
 #include "evldt/transport/lcm_log.hpp"
 
+#include <spdlog/spdlog.h>
 #include <algorithm>
 #include <fstream>
-#include <spdlog/spdlog.h>
 #include <stdexcept>
 
 #include "evldt/transport/messages.hpp"
@@ -27,8 +27,9 @@ LcmLogEventReader::LcmLogEventReader(const std::filesystem::path& path, std::str
                                      Timestamp backwards_slack_us)
     : channel_(std::move(channel)), log_(path), receiver_(std::nullopt, backwards_slack_us) {
   if (!next_batch(first_)) {
-    throw std::runtime_error("no valid event batch on " + (channel_.empty() ? std::string("an EVENTS_* channel") : channel_) +
-                             " in LCM log " + log_.path().string());
+    throw std::runtime_error("no valid event batch on " +
+                             (channel_.empty() ? std::string("an EVENTS_* channel") : channel_) + " in LCM log " +
+                             log_.path().string());
   }
   first_pending_ = true;
 }
@@ -86,14 +87,16 @@ std::vector<SegmentRow> read_segment_log(const std::filesystem::path& path, std:
     step_t = msg.t_us;
     std::sort(lines.begin(), lines.end(), [](const TrackedLine& a, const TrackedLine& b) { return a.id < b.id; });
     for (const TrackedLine& line : lines) {
-      rows.push_back({msg.t_us, line.id, line.segment, line.score, line.status, line.normal_velocity, line.normal_velocity_std});
+      rows.push_back(
+          {msg.t_us, line.id, line.segment, line.score, line.status, line.normal_velocity, line.normal_velocity_std});
     }
   }
   log.report();
   if (invalid) spdlog::warn("{}: {} invalid segment lists skipped", path.string(), invalid);
   if (!any_list) {
-    throw std::runtime_error("no valid segment list on " + (channel.empty() ? std::string("a LINES_* channel") : channel) +
-                             " in LCM log " + path.string());
+    throw std::runtime_error("no valid segment list on " +
+                             (channel.empty() ? std::string("a LINES_* channel") : channel) + " in LCM log " +
+                             path.string());
   }
   return rows;
 }

@@ -1,8 +1,8 @@
 #include "evldt/transport/lcm_log_reader.hpp"
 
+#include <spdlog/spdlog.h>
 #include <algorithm>
 #include <array>
-#include <spdlog/spdlog.h>
 #include <stdexcept>
 
 namespace evldt {
@@ -74,9 +74,11 @@ bool LcmLogReader::next(Record& record) {
       skip_to(at, find_sync(at + 1));  // a damaged header, or a sync word inside other bytes
       continue;
     }
-    const std::uint64_t end = at + kHeaderBytes + static_cast<std::uint64_t>(channel_bytes) + static_cast<std::uint64_t>(data_bytes);
+    const std::uint64_t end =
+        at + kHeaderBytes + static_cast<std::uint64_t>(channel_bytes) + static_cast<std::uint64_t>(data_bytes);
     std::uint8_t after[4] = {};
-    const bool followed = end == size_ || (end < size_ && size_ - end >= 4 && read_at(end, after, 4) && load_be(after, 4) == kSync);
+    const bool followed =
+        end == size_ || (end < size_ && size_ - end >= 4 && read_at(end, after, 4) && load_be(after, 4) == kSync);
     if (!followed) {
       // Lengths that run past the next record's start, or past the end of the file, are damaged when
       // a record starts inside them; otherwise the record is whole (the bytes after it are read, and
@@ -106,15 +108,18 @@ bool LcmLogReader::next(Record& record) {
   return false;
 }
 
-double LcmLogReader::progress() const { return size_ > 0 ? static_cast<double>(position_) / static_cast<double>(size_) : 1.0; }
+double LcmLogReader::progress() const {
+  return size_ > 0 ? static_cast<double>(position_) / static_cast<double>(size_) : 1.0;
+}
 
 void LcmLogReader::report() const {
   if (damage_.regions > 0) {
-    spdlog::warn("{}: {} damaged bytes skipped in {} place(s), the first at byte {}: the records there are lost", path_.string(),
-                 damage_.skipped_bytes, damage_.regions, damage_.first_at);
+    spdlog::warn("{}: {} damaged bytes skipped in {} place(s), the first at byte {}: the records there are lost",
+                 path_.string(), damage_.skipped_bytes, damage_.regions, damage_.first_at);
   }
   if (damage_.cut) {
-    spdlog::warn("{}: the last record (at byte {}) is cut short by the end of the file: it is lost", path_.string(), damage_.cut_at);
+    spdlog::warn("{}: the last record (at byte {}) is cut short by the end of the file: it is lost", path_.string(),
+                 damage_.cut_at);
   }
 }
 

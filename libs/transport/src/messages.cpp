@@ -95,9 +95,12 @@ constexpr std::size_t kMaxMessageBytes = 64u << 20;
 
 std::string_view wire_error_name(WireError error) {
   switch (error) {
-    case WireError::None: return "none";
-    case WireError::WrongType: return "wrong message type";
-    case WireError::Malformed: return "malformed";
+    case WireError::None:
+      return "none";
+    case WireError::WrongType:
+      return "wrong message type";
+    case WireError::Malformed:
+      return "malformed";
   }
   return "?";
 }
@@ -115,9 +118,9 @@ WireError decode_message(std::span<const std::uint8_t> bytes, stats_t& out) {
   if (bytes.size() > kMaxMessageBytes) return WireError::Malformed;
   WireWalker walker(bytes);
   if (const auto hash = check_hash<stats_t>(walker); hash != WireError::None) return hash;
-  const bool well_formed =
-      walker.skip(2 * 8) && walker.skip_string() && walker.skip_string() && walker.skip(kStatsMiddleBytes) && walker.skip_string() &&
-      walker.skip(4 * 8) && walker.counted_tail(4);
+  const bool well_formed = walker.skip(2 * 8) && walker.skip_string() && walker.skip_string() &&
+                           walker.skip(kStatsMiddleBytes) && walker.skip_string() && walker.skip(4 * 8) &&
+                           walker.counted_tail(4);
   return decode_checked(bytes, out, well_formed);
 }
 
@@ -125,8 +128,8 @@ WireError decode_message(std::span<const std::uint8_t> bytes, camera_info_t& out
   if (bytes.size() > kMaxMessageBytes) return WireError::Malformed;
   WireWalker walker(bytes);
   if (const auto hash = check_hash<camera_info_t>(walker); hash != WireError::None) return hash;
-  const bool well_formed = walker.skip(2 * 8) && walker.skip_string() && walker.skip(2 * 2 + 4 * 8) && walker.skip_string() &&
-                           walker.skip_string() && walker.counted_tail(8);
+  const bool well_formed = walker.skip(2 * 8) && walker.skip_string() && walker.skip(2 * 2 + 4 * 8) &&
+                           walker.skip_string() && walker.skip_string() && walker.counted_tail(8);
   return decode_checked(bytes, out, well_formed);
 }
 
@@ -186,7 +189,8 @@ void encode_event_batch(const event_batch_t& header, const EventBatch& events, s
   std::uint64_t outside = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint64_t d = static_cast<std::uint64_t>(ts[i]) - static_cast<std::uint64_t>(t_base);
-    outside |= ((d + (std::uint64_t{1} << 31)) >> 32) | static_cast<std::uint64_t>(static_cast<std::uint32_t>(d) == 0x80000000u);
+    outside |= ((d + (std::uint64_t{1} << 31)) >> 32) |
+               static_cast<std::uint64_t>(static_cast<std::uint32_t>(d) == 0x80000000u);
   }
   if (outside != 0) throw std::invalid_argument("the events of one batch must lie within 2^31 us of its first");
   out.resize(8 + 3 * 8 + 4 + header.source.size() + 1 + 2 * 2 + 8 + 4 + n * kEventWireBytes);
@@ -229,14 +233,16 @@ void encode_event_batch(const event_batch_t& header, const EventBatch& events, s
 namespace {
 
 // Checks a whole event batch's framing and reads its scalar fields; `events` points at its columns.
-WireError decode_event_batch_header_at(std::span<const std::uint8_t> bytes, event_batch_t& header, const std::uint8_t*& events) {
+WireError decode_event_batch_header_at(std::span<const std::uint8_t> bytes, event_batch_t& header,
+                                       const std::uint8_t*& events) {
   if (bytes.size() > kMaxMessageBytes) return WireError::Malformed;
   WireWalker walker(bytes);
   if (const auto hash = check_hash<event_batch_t>(walker); hash != WireError::None) return hash;
   std::int32_t count = 0;
-  const bool header_ok = walker.read_i64(header.utime) && walker.read_i64(header.epoch) && walker.read_i64(header.seq) &&
-                         walker.read_string(header.source) && walker.read_i16(header.width) &&
-                         walker.read_i16(header.height) && walker.read_i64(header.t_base_us) && walker.read_i32(count);
+  const bool header_ok = walker.read_i64(header.utime) && walker.read_i64(header.epoch) &&
+                         walker.read_i64(header.seq) && walker.read_string(header.source) &&
+                         walker.read_i16(header.width) && walker.read_i16(header.height) &&
+                         walker.read_i64(header.t_base_us) && walker.read_i32(count);
   if (!header_ok || count < 0 || walker.remaining() != static_cast<std::size_t>(count) * kEventWireBytes) {
     return WireError::Malformed;
   }
@@ -267,7 +273,8 @@ WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_bat
   events.p.resize(kept);
   const Timestamp t_base = header.t_base_us;
   const auto decode = [&](auto step) {  // a constant step of 1 keeps the loops vectorised
-    for (std::size_t k = 0; k < kept; ++k) events.t[k] = t_base + static_cast<std::int32_t>(get_be32(dt + 4 * (first + k * step)));
+    for (std::size_t k = 0; k < kept; ++k)
+      events.t[k] = t_base + static_cast<std::int32_t>(get_be32(dt + 4 * (first + k * step)));
     // Negative coordinates arrive as 32768..65535: off every sensor, so the validator drops them.
     for (std::size_t k = 0; k < kept; ++k) events.x[k] = get_be16(xs + 2 * (first + k * step));
     for (std::size_t k = 0; k < kept; ++k) events.y[k] = get_be16(ys + 2 * (first + k * step));
@@ -283,7 +290,8 @@ WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_bat
 
 }  // namespace
 
-WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_batch_t& header, Timestamp& last_event_us) {
+WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_batch_t& header,
+                                    Timestamp& last_event_us) {
   const std::uint8_t* dt = nullptr;
   if (const WireError error = decode_event_batch_header_at(bytes, header, dt); error != WireError::None) return error;
   last_event_us = header.t_base_us;

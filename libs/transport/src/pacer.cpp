@@ -19,8 +19,8 @@ double Pacer::wait_until(Timestamp t, const std::atomic<bool>& stop) {
     anchor_t_ = t;
     return 0.0;
   }
-  const auto due = anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
-                                      std::chrono::duration<double, std::micro>(static_cast<double>(t - anchor_t_) / speed_));
+  const auto due = anchor_wall_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::micro>(
+                                      static_cast<double>(t - anchor_t_) / speed_));
   constexpr auto kStopCheck = std::chrono::milliseconds(100);
   for (auto now = Clock::now(); now < due && !stop.load(std::memory_order_relaxed); now = Clock::now()) {
     std::this_thread::sleep_for(std::min<Clock::duration>(due - now, kStopCheck));

@@ -11,7 +11,8 @@ PayloadQueue::PayloadQueue(std::size_t slots, std::size_t slot_bytes) : slots_(s
   for (Slot& slot : slots_) slot.bytes.resize(slot_bytes);  // zero-filled: every page touched now
 }
 
-bool PayloadQueue::push(std::span<const std::uint8_t> payload, std::int64_t received_utime, const std::atomic<bool>& stop) {
+bool PayloadQueue::push(std::span<const std::uint8_t> payload, std::int64_t received_utime,
+                        const std::atomic<bool>& stop) {
   std::size_t index = 0;
   {
     std::unique_lock lock(mutex_);

@@ -4,9 +4,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <httplib.h>
 #include <atomic>
 #include <charconv>
-#include <httplib.h>
 #include <opencv2/imgcodecs.hpp>  // its constants; the calls go through evldt::media
 #include <stdexcept>
 
@@ -16,7 +16,8 @@
 namespace evldt {
 
 void WebViewCounts::print(std::FILE* out) const {
-  fmt::print(out, "  web       {} pages, {} pictures sent ({} encoded), {} layer keys\n", pages, pictures, encoded, keys);
+  fmt::print(out, "  web       {} pages, {} pictures sent ({} encoded), {} layer keys\n", pages, pictures, encoded,
+             keys);
 }
 namespace {
 
@@ -24,16 +25,24 @@ std::string escape_html(const std::string& text) {
   std::string out;
   for (const char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
 }
-
 
 // The page: the picture, fetched again as soon as the last one is shown (a newer one, or 204 and a
 // short pause); the status and the layer buttons, every half second.
@@ -113,7 +122,8 @@ std::string page_for(const std::string& title) {
 }  // namespace
 
 WebView::WebView(WebViewOptions options) : options_(std::move(options)), server_(std::make_unique<httplib::Server>()) {
-  if (options_.jpeg_quality < 1 || options_.jpeg_quality > 100) throw std::invalid_argument("JPEG quality must be in 1..100");
+  if (options_.jpeg_quality < 1 || options_.jpeg_quality > 100)
+    throw std::invalid_argument("JPEG quality must be in 1..100");
   server_->set_keep_alive_timeout(2);  // an idle browser's connection is closed soon, and at a stop
   // SO_REUSEADDR only: httplib's default SO_REUSEPORT lets a second viz bind the same port and
   // take half of the browsers' connections.
@@ -123,7 +133,8 @@ WebView::WebView(WebViewOptions options) : options_(std::move(options)), server_
   });
   add_routes();
   const HttpAddress& address = options_.address;
-  port_ = address.port == 0 ? server_->bind_to_any_port(address.host) : (server_->bind_to_port(address.host, address.port) ? address.port : -1);
+  port_ = address.port == 0 ? server_->bind_to_any_port(address.host)
+                            : (server_->bind_to_port(address.host, address.port) ? address.port : -1);
   if (port_ <= 0) {
     throw std::runtime_error("cannot serve HTTP on " + address.host + ":" + std::to_string(address.port) +
                              " (port in use, or not an address of this host)");
@@ -236,8 +247,8 @@ std::string WebView::status_json() const {
   if (picture) {
     for (std::size_t i = 0; i < picture->layers.size(); ++i) {
       const WebLayer& layer = picture->layers[i];
-      json += std::string(i ? ", " : "") + "{\"key\": " + json_quoted(std::string(1, layer.key)) + ", \"name\": " + json_quoted(layer.name) +
-              ", \"shown\": " + (layer.shown ? "true" : "false") + "}";
+      json += std::string(i ? ", " : "") + "{\"key\": " + json_quoted(std::string(1, layer.key)) +
+              ", \"name\": " + json_quoted(layer.name) + ", \"shown\": " + (layer.shown ? "true" : "false") + "}";
     }
   }
   return json + "]}";
@@ -284,7 +295,8 @@ void WebView::add_routes() {
   server_->Post(R"(/key/(.))", [this](const httplib::Request& request, httplib::Response& response) {
     const char key = request.matches[1].str().front();
     const auto picture = newest();
-    const bool known = picture && std::ranges::any_of(picture->layers, [&](const WebLayer& layer) { return layer.key == key; });
+    const bool known =
+        picture && std::ranges::any_of(picture->layers, [&](const WebLayer& layer) { return layer.key == key; });
     if (!known) {
       response.status = 404;
       response.set_content(std::string("no layer has the key '") + key + "'\n", "text/plain");

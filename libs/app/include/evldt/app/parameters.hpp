@@ -30,10 +30,10 @@ struct Parameter {
   std::string_view flag{};   ///< without "--"
   std::string_view group{};  ///< the --help group and the page's section
   Type type = Type::Real;
-  double min = 0, max = 0;  ///< numbers: the range, both ends included
-  bool above_min = false;   ///< numbers: min itself excluded
+  double min = 0, max = 0;                  ///< numbers: the range, both ends included
+  bool above_min = false;                   ///< numbers: min itself excluded
   std::vector<std::string_view> choices{};  ///< text: the values allowed (empty: checked when set)
-  std::string_view unit{};    ///< "px", "b" (block sides), "us", "degrees", "Hz", or empty
+  std::string_view unit{};                  ///< "px", "b" (block sides), "us", "degrees", "Hz", or empty
   std::string_view help{};
   Field field{};
   /// The default where it is not PipelineConfig's for the sensor size (a machine's, the header's).

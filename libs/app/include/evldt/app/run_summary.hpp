@@ -17,7 +17,7 @@ struct RunSummary {
   std::uint64_t events_read = 0;
   DecodeCounts decoded;  ///< words the recording's decoder skipped, trigger events it counted
   DropCounts drops;
-  std::string filters;     ///< the chain, "none" for no filter
+  std::string filters;  ///< the chain, "none" for no filter
   FilterCounts filtered;
   std::string calibration = "none";  ///< the calibration file, "none" for none
   double event_seconds = 0;
@@ -31,7 +31,7 @@ struct RunSummary {
   std::uint64_t csv_rows = 0;
   std::uint64_t whole_lines_created = 0;  ///< with a whole-line CSV: distinct whole-line ids
   std::uint64_t whole_line_rows = 0;
-  std::string whole_lines_path;          ///< empty: no whole lines written
+  std::string whole_lines_path;  ///< empty: no whole lines written
   int frames = 0;
 
   /// Takes the filter chain, its counts, the round counters, line counts and lifetimes (released

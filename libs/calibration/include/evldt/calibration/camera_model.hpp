@@ -9,14 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "evldt/events/event.hpp"
 #include "evldt/calibration/rectifier.hpp"
+#include "evldt/events/event.hpp"
 
 namespace evldt {
 
 struct CameraModel {
   enum class Distortion { None, RadialTangential, Equidistant };
-  SensorSize size{0, 0};  ///< {0, 0} where the file does not say (the ECD's calib.txt)
+  SensorSize size{0, 0};                  ///< {0, 0} where the file does not say (the ECD's calib.txt)
   double fx = 0, fy = 0, cx = 0, cy = 0;  ///< OpenCV's convention: pixel (x, y)'s centre is at (x, y)
   Distortion distortion = Distortion::None;
   /// RadialTangential (OpenCV, ROS plumb_bob, Kalibr radtan): k1 k2 p1 p2 [k3 [k4 k5 k6]];

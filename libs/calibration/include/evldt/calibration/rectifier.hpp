@@ -16,7 +16,7 @@ struct LensDescription {
   double fx = 0, fy = 0, cx = 0, cy = 0;  ///< of the rectified image, OpenCV's convention
   std::string distortion;                 ///< of the sensor: "none", "radtan", "equidistant"
   std::vector<double> coefficients;
-  std::string calibration;                ///< the file it was read from
+  std::string calibration;  ///< the file it was read from
 };
 
 struct RectificationTable {
@@ -55,7 +55,8 @@ struct RectificationTable {
 class Rectifier {
  public:
   explicit Rectifier(const RectificationTable& table)
-      : table_(&table), turn_(static_cast<std::size_t>(table.sensor.width) * static_cast<std::size_t>(table.sensor.height), 0) {}
+      : table_(&table),
+        turn_(static_cast<std::size_t>(table.sensor.width) * static_cast<std::size_t>(table.sensor.height), 0) {}
   /// `out` = the events of `in` at rectified pixels, in order; those of a pixel that feeds none left
   /// out. A pixel that feeds several sends its events to each in turn: the rectified edge is held at
   /// every pixel, and no event is counted twice.
@@ -77,7 +78,8 @@ class Rectifier {
         k += turn % count;
         turn = static_cast<std::uint8_t>(turn + 1);
       }
-      out.push_back(in.t[i], static_cast<std::uint16_t>(targets[k] & 0xFFFFu), static_cast<std::uint16_t>(targets[k] >> 16), in.p[i]);
+      out.push_back(in.t[i], static_cast<std::uint16_t>(targets[k] & 0xFFFFu),
+                    static_cast<std::uint16_t>(targets[k] >> 16), in.p[i]);
     }
   }
   /// Events left out so far: their pixel feeds no rectified pixel.

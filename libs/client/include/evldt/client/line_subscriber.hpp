@@ -31,7 +31,7 @@ enum class LineStatus : std::int8_t { Detected = 0, GoodTrack = 1, BadTrack = 2 
 struct Line {
   std::int64_t id = 0;  ///< the same line keeps its id from list to list
   float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-  float score = 0;      ///< fitting score
+  float score = 0;  ///< fitting score
   LineStatus status = LineStatus::Detected;
   /// px/s across itself, along (-(y1 - y0), x1 - x0) / length (for a line drawn left to right,
   /// positive is down the image), and the standard deviation of that estimate.
@@ -42,9 +42,9 @@ struct Line {
 struct LineList {
   bool whole_lines = false;  ///< WHOLE_LINES_<CAMERA> (edges across blocks) or LINES_<CAMERA> (segments)
   std::string camera;
-  int width = 0, height = 0;  ///< the sensor
-  std::int64_t t_us = 0;      ///< event time of the lattice state
-  std::int64_t utime = 0;     ///< wall clock at publication, us since the Unix epoch
+  int width = 0, height = 0;            ///< the sensor
+  std::int64_t t_us = 0;                ///< event time of the lattice state
+  std::int64_t utime = 0;               ///< wall clock at publication, us since the Unix epoch
   std::int64_t newest_batch_utime = 0;  ///< utime - this: the end-to-end latency
   std::vector<Line> lines;
 };

@@ -19,7 +19,7 @@ struct RecordingImage {
   std::uint32_t width = 0, height = 0;
   std::string encoding;  ///< ROS's names: "mono8", "mono16", "bgr8", "rgb8"...
   bool big_endian = false;
-  std::uint32_t step = 0;  ///< bytes per row
+  std::uint32_t step = 0;              ///< bytes per row
   std::span<const std::uint8_t> data;  ///< at least step * height bytes, valid until the next image
 };
 

@@ -19,11 +19,11 @@ namespace evldt {
 
 /// One packet of encoded events as a container stores it.
 struct RecordingPacket {
-  std::vector<std::uint8_t> bytes;  ///< the encoded events
-  std::string encoding;             ///< e.g. "evt3", "libcaer": the decoder to use
-  std::int64_t time_base_ns = 0;    ///< for encodings that count time from the packet
-  std::optional<SensorSize> sensor; ///< when the packet says
-  std::string location;             ///< where the packet is, for errors: "byte 1234", "message 17"
+  std::vector<std::uint8_t> bytes;   ///< the encoded events
+  std::string encoding;              ///< e.g. "evt3", "libcaer": the decoder to use
+  std::int64_t time_base_ns = 0;     ///< for encodings that count time from the packet
+  std::optional<SensorSize> sensor;  ///< when the packet says
+  std::string location;              ///< where the packet is, for errors: "byte 1234", "message 17"
 };
 
 /// A message's width and height as a sensor size, if they make one (a valid size, kMaxSensorSide at most).
@@ -81,8 +81,9 @@ class PacketEventReader {
 };
 
 /// The container `path` holds, recognised by its first bytes (SQLite for a ROS 2 bag, "#ROSBAG V2.0"
-/// for a ROS 1 bag, "\x89MCAP0" for MCAP, "#!AER-DAT4.0" for AEDAT 4), or nullptr for a file that is none. `topic` picks a bag's topic (empty: the first
-/// with an event message type). Throws std::runtime_error / FormatError for a container it cannot use.
+/// for a ROS 1 bag, "\x89MCAP0" for MCAP, "#!AER-DAT4.0" for AEDAT 4), or nullptr for a file that is none. `topic`
+/// picks a bag's topic (empty: the first with an event message type). Throws std::runtime_error / FormatError for a
+/// container it cannot use.
 std::unique_ptr<PacketSource> open_packet_container(const std::filesystem::path& path, const std::string& topic);
 
 }  // namespace evldt

@@ -29,13 +29,12 @@ inline constexpr std::string_view kRos2EventPacketType = "event_camera_msgs/msg/
 
 enum class RosSerialization { Ros1, Cdr };
 
-
 /// The fields of an event message that a reader uses.
 struct RosEventMessage {
   std::string frame_id;
   std::uint32_t width = 0, height = 0;
-  std::string encoding;         ///< "dvs_events" for an EventArray, else the EventPacket's
-  std::uint64_t time_base = 0;  ///< ns; EventPacket only
+  std::string encoding;                  ///< "dvs_events" for an EventArray, else the EventPacket's
+  std::uint64_t time_base = 0;           ///< ns; EventPacket only
   std::span<const std::uint8_t> events;  ///< into the message, or into `scratch`
 };
 
@@ -46,7 +45,8 @@ class RosEventLayout {
   /// topic, empty where it stores none) describes them: dvs_msgs/EventArray, or a message of the
   /// packet family (event_camera_msgs/EventPacket is known without a definition); nullopt if such
   /// messages hold no events evldt reads.
-  static std::optional<RosEventLayout> of(RosSerialization serialization, std::string_view type, std::string_view definition);
+  static std::optional<RosEventLayout> of(RosSerialization serialization, std::string_view type,
+                                          std::string_view definition);
 
   /// Decodes a message. An EventArray in CDR, whose records are padded by their alignment, is repacked
   /// into `scratch` as dvs_events records. Throws std::runtime_error with the reason (and offset)

@@ -73,7 +73,8 @@ struct EdgeRecallBin {
 };
 /// The steps binned by one of their values at the given bin edges (NaN values go in no bin).
 enum class EdgeMeasure { NormalSpeed, Length, ParallelGap };
-std::vector<EdgeRecallBin> bin_edge_recall(std::span<const EdgeStep> steps, EdgeMeasure measure, std::span<const double> edges);
+std::vector<EdgeRecallBin> bin_edge_recall(std::span<const EdgeStep> steps, EdgeMeasure measure,
+                                           std::span<const double> edges);
 /// The three tables (speed, length, parallel gap) as text, with each bin's share of all pixels.
 std::string edge_recall_tables(std::span<const EdgeStep> steps);
 /// One row per EdgeStep: run,t_us,gt_id,length_px,normal_speed_px_s,parallel_gap_px,pixels,matched.
@@ -82,6 +83,7 @@ std::string edge_recall_csv_rows(const std::string& run, std::span<const EdgeSte
 /// The kept step drawn `scale` times the sensor's size: true edges' pixels green where matched and
 /// red where missed, the predicted segments in blue over them. Throws std::runtime_error when there
 /// is no picture or it cannot be written.
-void write_edge_recall_png(const std::filesystem::path& path, const EdgeRecall& recall, const std::string& title, int scale = 3);
+void write_edge_recall_png(const std::filesystem::path& path, const EdgeRecall& recall, const std::string& title,
+                           int scale = 3);
 
 }  // namespace evldt

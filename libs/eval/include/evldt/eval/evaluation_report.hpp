@@ -25,7 +25,7 @@ struct EvaluationReport {
   /// when not scored), by their speed across themselves (none: by the events along them).
   std::vector<Prf> visible;
   std::optional<float> visible_min_normal_speed;
-  double visible_share = 0;  ///< of the true pixels, those seen (NaN without any)
+  double visible_share = 0;                         ///< of the true pixels, those seen (NaN without any)
   std::vector<StreamEvaluator::Second> per_second;  ///< cumulative, at the first tolerance
   std::optional<Timestamp> seconds_origin;          ///< t0 of per_second
 };

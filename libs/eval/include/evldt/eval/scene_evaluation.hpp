@@ -43,8 +43,8 @@ GroundTruthSteps steps_within(GroundTruthSteps truth, Timestamp first, Timestamp
 
 /// Splits the true pieces of step `index` into what an events-only camera can see and what it
 /// cannot (visible_score.hpp).
-using VisibilitySplit = std::function<void(std::size_t index, std::span<const Segment> truth, std::vector<Segment>& visible,
-                                           std::vector<Segment>& hidden)>;
+using VisibilitySplit = std::function<void(std::size_t index, std::span<const Segment> truth,
+                                           std::vector<Segment>& visible, std::vector<Segment>& hidden)>;
 
 /// Scoring also against what an events-only camera can see: by the true edges' speed across
 /// themselves (simulated ground truth), or by a split of its own (LSD's lines with event support).
@@ -180,7 +180,8 @@ class StreamEvaluator {
 /// How long a predicted step of `rows` (any order) holds when scored: StreamEvaluator::kHoldPeriods of
 /// `output_period_us`, else of the median spacing of their steps, else (fewer than two steps) of the
 /// ground truth's.
-Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_period_us, std::span<const Timestamp> truth_times);
+Timestamp prediction_hold_us(std::span<const SegmentRow> rows, Timestamp output_period_us,
+                             std::span<const Timestamp> truth_times);
 /// Scores predicted segment rows (of a CSV, a log or Python; any order, sorted by time here) on
 /// ground-truth steps with StreamEvaluator's rule and a hold of kHoldPeriods output periods.
 /// output_period_us 0: the median spacing of the predicted steps (of the ground truth's, with fewer

@@ -46,8 +46,8 @@ struct IdSwitchCauses {
   std::uint64_t to_other_edge = 0;  ///< the old id is published and now matches another true line
   std::uint64_t off_edge = 0;       ///< the old id is published and matches no true line (it drifted or lags)
   std::uint64_t returned = 0;       ///< the old id is not published at this step but comes back later
-  std::uint64_t redetected = 0;     ///< the old id is gone for good and the new one first appeared after it was last seen
-  std::uint64_t taken_over = 0;     ///< the old id is gone for good and the new one was already published before that
+  std::uint64_t redetected = 0;  ///< the old id is gone for good and the new one first appeared after it was last seen
+  std::uint64_t taken_over = 0;  ///< the old id is gone for good and the new one was already published before that
   /// Of all switches: those after one or more steps at which nothing matched the true line.
   std::uint64_t after_gap = 0;
 };
@@ -158,8 +158,8 @@ class TrackingEvaluator {
   std::vector<std::size_t> first_piece_;    ///< per step line: its first truth piece
   std::vector<std::size_t> slot_of_line_;   ///< position in step_lines_ of each line seen (or npos)
   std::vector<double> overlap_by_line_;
-  std::vector<std::size_t> hit_stamp_;      ///< per step line: the last sample that counted for it
-  std::vector<std::size_t> candidates_;     ///< truth pieces near the segment being measured
+  std::vector<std::size_t> hit_stamp_;   ///< per step line: the last sample that counted for it
+  std::vector<std::size_t> candidates_;  ///< truth pieces near the segment being measured
   std::vector<Match> matches_;
   bool stepped_ = false;
   Timestamp last_t_ = 0;

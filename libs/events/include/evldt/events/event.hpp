@@ -28,7 +28,8 @@ struct SensorSize {
   /// The error message for a size valid() refuses.
   [[nodiscard]] std::string range_error() const {
     const std::string side = std::to_string(kMaxSensorSide);
-    return "sensor size " + std::to_string(width) + "x" + std::to_string(height) + " is not in 1x1.." + side + "x" + side;
+    return "sensor size " + std::to_string(width) + "x" + std::to_string(height) + " is not in 1x1.." + side + "x" +
+           side;
   }
   friend bool operator==(const SensorSize&, const SensorSize&) = default;
 };
@@ -115,7 +116,8 @@ class EventBatch::Appender {
   Appender& operator=(const Appender&) = delete;
 
   void push_back(Timestamp time, std::uint16_t px, std::uint16_t py, std::int8_t polarity) {
-    if (size_ == columns_.room) [[unlikely]] columns_ = grow(batch_, size_);
+    if (size_ == columns_.room) [[unlikely]]
+      columns_ = grow(batch_, size_);
     columns_.t[size_] = time;
     columns_.x[size_] = px;
     columns_.y[size_] = py;

@@ -143,7 +143,7 @@ class TextHeader {
 
   char marker_;
   std::vector<std::string> lines_;
-  std::string line_;           // the header line being read
+  std::string line_;  // the header line being read
   std::uint64_t line_start_ = 0;
   bool in_line_ = false;
   bool complete_ = false;

@@ -38,7 +38,8 @@ const T* verified_size_prefixed_root(std::span<const std::uint8_t> bytes, std::v
       data = reinterpret_cast<const std::uint8_t*>(scratch.data());
     }
     flatbuffers::Verifier verifier(data, from.size());
-    if (at_prefix) return verifier.VerifySizePrefixedBuffer<T>(nullptr) ? flatbuffers::GetSizePrefixedRoot<T>(data) : nullptr;
+    if (at_prefix)
+      return verifier.VerifySizePrefixedBuffer<T>(nullptr) ? flatbuffers::GetSizePrefixedRoot<T>(data) : nullptr;
     return sized_right && verifier.VerifyBuffer<T>(nullptr) ? flatbuffers::GetRoot<T>(data) : nullptr;
   };
   const bool prefix_first = bytes.size() % alignof(std::uint64_t) == 0;

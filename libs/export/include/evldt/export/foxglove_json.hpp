@@ -8,23 +8,24 @@
 #include <span>
 #include <string>
 
-#include "evldt/lines/line_types.hpp"
 #include "evldt/camera_info_t.hpp"
+#include "evldt/lines/line_types.hpp"
 #include "evldt/stats_t.hpp"
 
 namespace evldt {
 
 /// The JSON Schemas written into an MCAP file with the messages (schema encoding "jsonschema"),
 /// describing the fields evldt writes.
-const std::string& compressed_image_schema();   ///< foxglove.CompressedImage
-const std::string& image_annotations_schema();  ///< foxglove.ImageAnnotations
-const std::string& stats_schema();              ///< evldt.Stats
-const std::string& camera_calibration_schema(); ///< foxglove.CameraCalibration
+const std::string& compressed_image_schema();    ///< foxglove.CompressedImage
+const std::string& image_annotations_schema();   ///< foxglove.ImageAnnotations
+const std::string& stats_schema();               ///< evldt.Stats
+const std::string& camera_calibration_schema();  ///< foxglove.CameraCalibration
 
 std::string base64(std::span<const std::uint8_t> bytes);
 
 /// A JPEG picture taken at `time_ns` (ns since the epoch).
-std::string compressed_image_json(std::uint64_t time_ns, const std::string& frame_id, std::span<const std::uint8_t> jpeg);
+std::string compressed_image_json(std::uint64_t time_ns, const std::string& frame_id,
+                                  std::span<const std::uint8_t> jpeg);
 
 struct AnnotationStyle {
   double thickness = 1;
@@ -35,7 +36,8 @@ struct AnnotationStyle {
   bool motion = false;
 };
 /// Lines as line lists (one per colour) and, with style.ids, their ids; coordinates times `scale`.
-std::string image_annotations_json(std::uint64_t time_ns, std::span<const TrackedLine> lines, const AnnotationStyle& style, int scale);
+std::string image_annotations_json(std::uint64_t time_ns, std::span<const TrackedLine> lines,
+                                   const AnnotationStyle& style, int scale);
 
 /// The lines service's statistics.
 std::string stats_json(std::uint64_t time_ns, const stats_t& stats);

@@ -18,8 +18,8 @@ struct FilterConfig {
   /// Filters in the order they run: "hot-pixel", "background-activity", "refractory", "anti-flicker".
   std::vector<std::string> chain = {"refractory", "hot-pixel", "anti-flicker", "background-activity"};
   Timestamp background_window_us = 5000;  ///< tuned on boxes-6dof, clean and noisy (docs/accuracy.md, noise filters)
-  double background_min_noise_hz = 1.0;    ///< background-activity drops only above this uncorrelated rate per pixel
-  Timestamp refractory_us = 300;  ///< tuned on the built-in scenes (docs/accuracy.md, noise filters)
+  double background_min_noise_hz = 1.0;   ///< background-activity drops only above this uncorrelated rate per pixel
+  Timestamp refractory_us = 300;          ///< tuned on the built-in scenes (docs/accuracy.md, noise filters)
   HotPixelParams hot_pixel;
   AntiFlickerParams anti_flicker;
 };

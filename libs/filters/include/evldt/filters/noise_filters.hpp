@@ -27,11 +27,11 @@ namespace evldt {
 /// What anti-flicker keeps about one pixel and polarity, 12 bytes. Times are the low 32 bits of us:
 /// differences are exact for gaps under 71 minutes.
 struct FlickerBurst {
-  std::uint32_t start;       // time of the current burst's first event
+  std::uint32_t start;  // time of the current burst's first event
   std::uint32_t last_event;
-  std::uint16_t period;      // us, the locked or candidate period
-  std::uint8_t streak;       // consistent periods in a row
-  std::uint8_t flags;        // AntiFlickerFilter::kSeen, kFlickerBurst
+  std::uint16_t period;  // us, the locked or candidate period
+  std::uint8_t streak;   // consistent periods in a row
+  std::uint8_t flags;    // AntiFlickerFilter::kSeen, kFlickerBurst
 };
 
 /// What refractory and anti-flicker keep about one pixel: 32 bytes (4 of them padding), two to a
@@ -57,14 +57,17 @@ class BackgroundActivityFilter {
 
   /// Row stride of the surface of last-event times the filter reads: the sensor with a one-pixel
   /// border, so neighbours need no bounds checks.
-  [[nodiscard]] static std::size_t surface_stride(SensorSize sensor) { return static_cast<std::size_t>(sensor.width) + 2; }
+  [[nodiscard]] static std::size_t surface_stride(SensorSize sensor) {
+    return static_cast<std::size_t>(sensor.width) + 2;
+  }
   [[nodiscard]] static std::size_t surface_size(SensorSize sensor) {
     return surface_stride(sensor) * (static_cast<std::size_t>(sensor.height) + 2);
   }
 
   /// The test of an event at time t whose pixel's cell of the surface is `centre`.
   [[gnu::always_inline]] bool pass(Timestamp t, std::uint32_t* centre) {
-    if (t >= judge_end_) [[unlikely]] judge(t);  // before the test: it uses none of what judging changes
+    if (t >= judge_end_) [[unlikely]]
+      judge(t);  // before the test: it uses none of what judging changes
     const auto now = static_cast<std::uint32_t>(t) - origin_;
     const std::ptrdiff_t s = stride_;
     const auto recent = [&](std::uint32_t last) { return now - last <= window_us_; };
@@ -72,9 +75,9 @@ class BackgroundActivityFilter {
     // row, an isolated noise event rarely does (measured: on boxes-6dof this keeps F@1% at or above
     // no filter where the 8 neighbours alone cost 0.04 at a 10 ms window).
     // (Short-circuit: measured faster than reading all nine without branches, noisy scenes included.)
-    const bool correlated = recent(centre[0]) || recent(centre[-s - 1]) || recent(centre[-s]) || recent(centre[-s + 1]) ||
-                            recent(centre[-1]) || recent(centre[1]) || recent(centre[s - 1]) || recent(centre[s]) ||
-                            recent(centre[s + 1]);
+    const bool correlated = recent(centre[0]) || recent(centre[-s - 1]) || recent(centre[-s]) ||
+                            recent(centre[-s + 1]) || recent(centre[-1]) || recent(centre[1]) ||
+                            recent(centre[s - 1]) || recent(centre[s]) || recent(centre[s + 1]);
     *centre = now;
     uncorrelated_ += correlated ? 0 : 1;
     if (correlated || !active_) return true;
@@ -112,7 +115,8 @@ class RefractoryFilter {
 
   /// The test of an event at time t at pixel `pixel` (y * width + x) of `states` (the chain's table).
   [[gnu::always_inline]] bool pass(Timestamp t, std::uint32_t pixel, PixelState* states) {
-    if (t >= next_sweep_) [[unlikely]] sweep(t, states);
+    if (t >= next_sweep_) [[unlikely]]
+      sweep(t, states);
     std::uint32_t& last = states[pixel].refractory;
     const auto now = static_cast<std::uint32_t>(t - origin_);
     // Exact: every stored time is within 2^31 us of t (see sweep()).
@@ -161,7 +165,8 @@ class HotPixelFilter {
   /// The test of an event at time t at pixel `pixel` (y * width + x) of `counts` (the chain's plane
   /// of counts, one per pixel): counts the event, after judging the window it ends.
   [[gnu::always_inline]] bool pass(Timestamp t, std::uint32_t pixel, std::uint32_t* counts) {
-    if (t >= window_end_) [[unlikely]] end_window(t, counts);
+    if (t >= window_end_) [[unlikely]]
+      end_window(t, counts);
     std::uint32_t& count = counts[pixel];
     ++count;  // the count stays far below kMasked: a window of a few seconds at any real rate
     if ((count & kMasked) == 0) return true;
@@ -192,11 +197,11 @@ class HotPixelFilter {
 };
 
 struct AntiFlickerParams {
-  double min_hz = 50;            ///< the band of flicker frequencies (mains lights flicker at 100 or
-  double max_hz = 520;           ///< 120 Hz, LED PWM up to some hundreds of Hz)
-  int lock_periods = 3;          ///< consistent periods in a row before a pixel's bursts count as flicker
-  double tolerance = 0.1;        ///< of a period, for a burst to fall on the predicted phase
-  Timestamp burst_gap_us = 1000; ///< events of one polarity closer than this at a pixel are one burst
+  double min_hz = 50;             ///< the band of flicker frequencies (mains lights flicker at 100 or
+  double max_hz = 520;            ///< 120 Hz, LED PWM up to some hundreds of Hz)
+  int lock_periods = 3;           ///< consistent periods in a row before a pixel's bursts count as flicker
+  double tolerance = 0.1;         ///< of a period, for a burst to fall on the predicted phase
+  Timestamp burst_gap_us = 1000;  ///< events of one polarity closer than this at a pixel are one burst
 };
 
 void check_params(const AntiFlickerParams& params);
@@ -254,7 +259,8 @@ inline bool AntiFlickerFilter::new_burst(std::uint32_t now, FlickerBurst& burst)
     const std::uint32_t period = burst.period;
     const std::uint32_t n = (since + period / 2) / period;
     if (n >= 1 && n <= 3 && near(since, n * period)) {
-      if (n == 1 && since <= max_period_) burst.period = static_cast<std::uint16_t>(since);  // follows a drifting frequency
+      if (n == 1 && since <= max_period_)
+        burst.period = static_cast<std::uint16_t>(since);  // follows a drifting frequency
       burst.start = now;
       burst.flags |= kFlickerBurst;
       return false;
@@ -267,7 +273,8 @@ inline bool AntiFlickerFilter::new_burst(std::uint32_t now, FlickerBurst& burst)
   }
   // Acquiring: consecutive bursts at a steady period inside the band.
   if (since >= min_period_ && since <= max_period_) {
-    burst.streak = burst.streak > 0 && near(since, burst.period) ? static_cast<std::uint8_t>(burst.streak + 1) : std::uint8_t{1};
+    burst.streak =
+        burst.streak > 0 && near(since, burst.period) ? static_cast<std::uint8_t>(burst.streak + 1) : std::uint8_t{1};
     burst.period = static_cast<std::uint16_t>(since);
   } else {
     burst.streak = 0;

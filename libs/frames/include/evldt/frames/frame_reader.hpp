@@ -62,9 +62,10 @@ SensorSize frames_sensor_size(const std::filesystem::path& path, const std::stri
 /// mono8, mono16 (its high byte), bgr8 and rgb8, as grey); MVSEC's HDF5 frames `stream` (empty:
 /// /davis/left/image_raw, with its _ts times); the frames of an AEDAT 4.0 recording's first frame
 /// stream, of AEDAT 3.1 frame packets, of jAER's AEDAT 2.0 DAVIS APS samples (reset - signal), each at
-/// the middle of its exposure (libs/containers: aedat4.hpp, aedat_images.hpp); else a video file OpenCV opens (as grey, at its
-/// frame rate, else 30 fps, as --from-video emulates events from it). `sensor` {0, 0}: the first
-/// frame's size. Throws FrameError naming the path for anything else or a container without them.
-std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream, SensorSize sensor);
+/// the middle of its exposure (libs/containers: aedat4.hpp, aedat_images.hpp); else a video file OpenCV opens (as grey,
+/// at its frame rate, else 30 fps, as --from-video emulates events from it). `sensor` {0, 0}: the first frame's size.
+/// Throws FrameError naming the path for anything else or a container without them.
+std::unique_ptr<FrameReader> open_frames(const std::filesystem::path& path, const std::string& stream,
+                                         SensorSize sensor);
 
 }  // namespace evldt

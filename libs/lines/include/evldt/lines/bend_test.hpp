@@ -40,7 +40,8 @@ class BendTest {
   };
   /// Whether the edge runs on straight in the far half of the extension beyond `end`; `offsets`
   /// receives the offsets across the segment of the band's events there.
-  bool runs_straight(const ScarfLattice& lattice, const Frame& frame, Point2 end, Point2 outward, std::vector<float>& offsets);
+  bool runs_straight(const ScarfLattice& lattice, const Frame& frame, Point2 end, Point2 outward,
+                     std::vector<float>& offsets);
   /// Along one axis, the block (0 .. blocks - 1) whose region's centre is nearest `coordinate`.
   [[nodiscard]] int nearest_region(float coordinate, int blocks) const;
   /// The sign (-1, 0, 1) of the median of `offsets`, 0 when empty.
@@ -51,7 +52,7 @@ class BendTest {
 
   LatticeGeometry geometry_;
   float min_bend_px_;
-  std::vector<int> cells_;  // scratch: the blocks along the extended segment
+  std::vector<int> cells_;    // scratch: the blocks along the extended segment
   std::vector<float> u_, v_;  // scratch: the band's events in the segment's frame (v_ first: the offsets beyond q0)
   std::vector<float> after_;  // scratch: the offsets beyond q1
   // Scratch per entry of one block: its place in the segment's frame and what it counts for.

@@ -51,11 +51,11 @@ class LineDetector {
   ScoreParams params_;
   RoundWorkers* round_workers_;
   std::vector<Worker> workers_;
-  std::uint64_t versions_of_ = 0;         // the lattice whose block versions failed_at_ holds
-  std::vector<std::uint64_t> failed_at_;  // per block: its version at its last failed attempt
+  std::uint64_t versions_of_ = 0;               // the lattice whose block versions failed_at_ holds
+  std::vector<std::uint64_t> failed_at_;        // per block: its version at its last failed attempt
   std::vector<std::uint16_t> failed_arrivals_;  // per block: its ScarfLattice::active_arrivals at that attempt
-  std::uint16_t retry_after_;                    // new active entries before a failed block is fitted again
-  std::vector<Found> found_;              // per block
+  std::uint16_t retry_after_;                   // new active entries before a failed block is fitted again
+  std::vector<Found> found_;                    // per block
 };
 
 }  // namespace evldt

@@ -11,15 +11,17 @@
 namespace evldt {
 
 struct ScoreBreakdown {
-  float occupancy = 0;       ///< r_o: share of 1-px bins along the segment hit by an inlier, at most 1
-  float effective = 0;       ///< r_e: inliers / normaliser
-  int inliers = 0;           ///< points of the event set within d_max of the segment, along its length
+  float occupancy = 0;            ///< r_o: share of 1-px bins along the segment hit by an inlier, at most 1
+  float effective = 0;            ///< r_e: inliers / normaliser
+  int inliers = 0;                ///< points of the event set within d_max of the segment, along its length
   float inlier_distance_sum = 0;  ///< sum of d1 over the inliers
   /// Sum over the inliers of their signed distance along the segment's normal (normal_motion.hpp):
   /// divided by the inliers, where the middle of the event band lies off the segment.
   float inlier_offset_sum = 0;
   [[nodiscard]] float score() const { return occupancy * effective; }
-  [[nodiscard]] float mean_inlier_distance() const { return inliers ? inlier_distance_sum / static_cast<float>(inliers) : 0.0f; }
+  [[nodiscard]] float mean_inlier_distance() const {
+    return inliers ? inlier_distance_sum / static_cast<float>(inliers) : 0.0f;
+  }
   /// Ranks tracking hypotheses: the higher score wins; on a tie (common: f is a ratio of small counts,
   /// flat while an edge stays within d_max) the segment closer to its inliers wins, so the line
   /// follows the middle of its event band instead of waiting until the edge has almost left it.
@@ -40,9 +42,9 @@ class FittingScorer {
 
  private:
   float inlier_distance_;
-  std::vector<std::uint8_t> bins_;          // scratch: 1 where a 1-px bin holds an inlier (+ a spare bin), reused across calls
-  std::vector<std::int32_t> point_bins_;    // scratch: each point's bin
-  std::vector<float> point_offsets_;        // scratch: each point's signed distance if an inlier, else 0
+  std::vector<std::uint8_t> bins_;  // scratch: 1 where a 1-px bin holds an inlier (+ a spare bin), reused across calls
+  std::vector<std::int32_t> point_bins_;  // scratch: each point's bin
+  std::vector<float> point_offsets_;      // scratch: each point's signed distance if an inlier, else 0
 };
 
 }  // namespace evldt

@@ -122,8 +122,8 @@ class LineMap {
   std::vector<std::int32_t> owner_;  ///< per block: index into lines_ of the line it administers, or -1
   std::vector<TrackedLine> lines_;
   std::vector<std::uint64_t> settled_;  ///< per line, settled_version()
-  std::vector<NormalMotion> motion_;     ///< per line: the estimate of its motion across itself
-  std::vector<Point2> band_centre_;      ///< per line, band_centre()
+  std::vector<NormalMotion> motion_;    ///< per line: the estimate of its motion across itself
+  std::vector<Point2> band_centre_;     ///< per line, band_centre()
   std::uint64_t first_id_ = 1;
   std::uint64_t next_id_ = 1;
   std::uint64_t released_[kReleaseReasonCount] = {};

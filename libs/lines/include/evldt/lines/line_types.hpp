@@ -16,9 +16,12 @@ enum class LineStatus : std::uint8_t { Detected, GoodTrack, BadTrack };
 /// "detected", "good", "bad": the CSV's and the messages' names.
 inline std::string_view status_name(LineStatus status) {
   switch (status) {
-    case LineStatus::Detected: return "detected";
-    case LineStatus::GoodTrack: return "good";
-    case LineStatus::BadTrack: return "bad";
+    case LineStatus::Detected:
+      return "detected";
+    case LineStatus::GoodTrack:
+      return "good";
+    case LineStatus::BadTrack:
+      return "bad";
   }
   return "?";
 }

@@ -57,6 +57,7 @@ inline constexpr float kMotionArrowSeconds = 0.1f;
 void start_motion(NormalMotion& motion, const Segment& segment, Timestamp t_us, const MotionParams& params);
 /// One observation of the line at t_us (after the last): `segment` gives its direction, `at` a point
 /// on it (the middle of its event band). The line may turn: the velocity is along its current normal.
-void observe_motion(NormalMotion& motion, const Segment& segment, Point2 at, Timestamp t_us, const MotionParams& params);
+void observe_motion(NormalMotion& motion, const Segment& segment, Point2 at, Timestamp t_us,
+                    const MotionParams& params);
 
 }  // namespace evldt

@@ -57,14 +57,15 @@ struct TrackParams {
 /// because the block segments along an edge that moves across itself tilt by up to 15-20 degrees
 /// either way (a fit across its band of events): at 12 degrees none of them joined.
 struct WholeLineParams {
-  float max_angle_deg = 20.0f;     ///< a segment joins a line whose direction is this close to its own
-  float max_offset_ratio = 0.6f;   ///< of b: both its ends within this of the line
-  float max_gap_ratio = 2.0f;      ///< of b: and it overlaps the line's extent or is at most this far from it
+  float max_angle_deg = 20.0f;    ///< a segment joins a line whose direction is this close to its own
+  float max_offset_ratio = 0.6f;  ///< of b: both its ends within this of the line
+  float max_gap_ratio = 2.0f;     ///< of b: and it overlaps the line's extent or is at most this far from it
   /// A segment that was part of the line at the last step stays within this direction of it (and
   /// twice the offset and gap bounds: a line does not split for a step's wobble); also the bound of a
   /// waiting line looking for its edge, and of a second line along a published one.
   float loose_angle_deg = 24.0f;
-  Timestamp keep_id_us = 1'000'000;  ///< a line without segments for this long ends; before, it may take segments up again
+  Timestamp keep_id_us =
+      1'000'000;  ///< a line without segments for this long ends; before, it may take segments up again
   /// An end its segments no longer reach stays this long: a block segment at the end of an edge comes
   /// and goes with the events there, the edge does not.
   Timestamp end_memory_us = 100'000;

@@ -51,7 +51,8 @@ class PointGrid {
     const auto [cx, cy] = cell_xy(p);
     for (int y = std::max(0, cy - 1); y <= std::min(rows_ - 1, cy + 1); ++y) {
       for (int x = std::max(0, cx - 1); x <= std::min(columns_ - 1, cx + 1); ++x) {
-        const std::size_t c = static_cast<std::size_t>(y) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(x);
+        const std::size_t c =
+            static_cast<std::size_t>(y) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(x);
         for (std::uint32_t k = start_[c]; k < start_[c + 1]; ++k) visit(items_[k]);
       }
     }
@@ -65,7 +66,8 @@ class PointGrid {
     const auto clamp = [](float v, int count) {
       return v >= 0 ? static_cast<int>(std::min(v, static_cast<float>(count - 1))) : 0;
     };
-    return {clamp(std::floor(p.x() / cell_) - origin_x_, columns_), clamp(std::floor(p.y() / cell_) - origin_y_, rows_)};
+    return {clamp(std::floor(p.x() / cell_) - origin_x_, columns_),
+            clamp(std::floor(p.y() / cell_) - origin_y_, rows_)};
   }
 
   float cell_ = 1, origin_x_ = 0, origin_y_ = 0;

@@ -27,7 +27,8 @@ struct EndpointMotion {
 EndpointMotion endpoint_motion(const Point2& endpoint, const Point2& segment_direction, const LatticeGeometry& geometry,
                                float perturbation_px);
 
-/// Distance from a line centre to a neighbouring block below which that block is suppressed (docs/design.md, section 5).
+/// Distance from a line centre to a neighbouring block below which that block is suppressed (docs/design.md, section
+/// 5).
 inline constexpr float kSuppressRatio = 0.4f;
 
 class LineTracker {

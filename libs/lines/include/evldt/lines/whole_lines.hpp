@@ -141,7 +141,7 @@ class WholeLineTracker {
   WholeLineParams params_;
   const ScarfLattice* events_ = nullptr;  ///< of the current update(), or none
   mutable EventPixels event_pixels_;      ///< of events_: a cache, filled as the queries come
-  float cell_size_;  ///< of the grid of segment ends
+  float cell_size_;                       ///< of the grid of segment ends
   float min_cos_angle_;
   float loose_cos_angle_;  ///< of WholeLineParams::loose_angle_deg
   std::uint64_t first_id_;
@@ -154,15 +154,17 @@ class WholeLineTracker {
 
   // Scratch, kept between calls.
   std::vector<Point2> ends_;  ///< segment i's ends at 2i, 2i + 1 (published lines' in meet_at_corners)
-  PointGrid end_grid_;       ///< of the segments' ends
-  PointGrid corner_grid_;    ///< of the published lines' ends
+  PointGrid end_grid_;        ///< of the segments' ends
+  PointGrid corner_grid_;     ///< of the published lines' ends
   std::vector<std::uint32_t> order_, members_, cluster_of_segment_;
   std::vector<std::uint64_t> former_track_of_segment_;  ///< former_track_of() each segment (by index) of this step
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> segments_of_former_track_;  ///< (former track key, segment index), by key then length
+  std::vector<std::pair<std::uint64_t, std::uint32_t>>
+      segments_of_former_track_;  ///< (former track key, segment index), by key then length
   std::vector<Cluster> clusters_;
   std::vector<std::size_t> cluster_of_track_;  ///< index into clusters_ of each of tracks_, or npos
   std::vector<Track> next_tracks_;
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> track_of_segment_id_;  ///< (segment id, track key) of the last step, sorted
+  std::vector<std::pair<std::uint64_t, std::uint64_t>>
+      track_of_segment_id_;  ///< (segment id, track key) of the last step, sorted
   std::vector<std::pair<std::uint64_t, std::uint64_t>> next_track_of_segment_id_;
   struct Corner {
     float cost = 0;  ///< the two ends' distances to the corner
@@ -171,9 +173,9 @@ class WholeLineTracker {
   };
   std::vector<Corner> corners_;
   std::vector<std::uint8_t> end_moved_;
-  std::vector<Point2> line_samples_;          ///< points along the published lines, for reach_along_events
+  std::vector<Point2> line_samples_;  ///< points along the published lines, for reach_along_events
   std::vector<std::uint32_t> line_of_sample_;
-  PointGrid line_grid_;                       ///< of line_samples_
+  PointGrid line_grid_;  ///< of line_samples_
   std::vector<std::uint32_t> nearby_lines_;
   std::vector<Segment> reached_;
 };

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "evldt/events/event_validator.hpp"
 #include "evldt/event_batch_t.hpp"
+#include "evldt/events/event_validator.hpp"
 #include "evldt/sources/event_source.hpp"
 #include "evldt/transport/sensor_lag.hpp"
 
@@ -23,12 +23,12 @@ struct CameraNodeOptions {
   std::string camera = "cam0";
   std::optional<SensorSize> sensor;  ///< unset: the source's own
   Timestamp batch_us = 1000;
-  std::size_t max_batch = 7000;      ///< about one 64 KiB datagram
-  double speed = 1.0;                ///< 0: as fast as possible
+  std::size_t max_batch = 7000;  ///< about one 64 KiB datagram
+  double speed = 1.0;            ///< 0: as fast as possible
   bool loop = false;
   Timestamp time_slack_us = 1000;
-  double progress_period_s = 2;      ///< a progress line this often (0: none)
-  double stats_hz = 1;               ///< statistics on EVLDT_STATS this often, and once at the end (0: none)
+  double progress_period_s = 2;  ///< a progress line this often (0: none)
+  double stats_hz = 1;           ///< statistics on EVLDT_STATS this often, and once at the end (0: none)
 };
 
 struct CameraSummary {
@@ -36,13 +36,13 @@ struct CameraSummary {
   SensorSize sensor;
   std::uint64_t events_read = 0;
   std::uint64_t events_published = 0;
-  DecodeCounts decoded;              ///< words the recording's decoder skipped, trigger events it counted
+  DecodeCounts decoded;  ///< words the recording's decoder skipped, trigger events it counted
   DropCounts drops;
   std::uint64_t batches = 0;
   std::uint64_t publish_failures = 0;
-  std::uint64_t bytes = 0;           ///< encoded message bytes published
-  std::uint64_t loops = 0;           ///< times the source was restarted by --loop
-  double event_seconds = 0;          ///< event time spanned by the published batches
+  std::uint64_t bytes = 0;   ///< encoded message bytes published
+  std::uint64_t loops = 0;   ///< times the source was restarted by --loop
+  double event_seconds = 0;  ///< event time spanned by the published batches
   double wall_seconds = 0;
   double max_lag_s = 0;              ///< furthest behind the pace
   std::uint64_t skipped_gaps = 0;    ///< jumps of event time not waited through (Pacer)
@@ -70,17 +70,17 @@ class CameraNode {
 
   void publish(const EventBatch& batch, CameraSummary& summary);
   /// The statistics so far; `rate_events` published since the last ones, over `period_s`.
-  void publish_stats(const CameraSummary& summary, const DecodeCounts& decoded, const DropCounts& drops, double period_s,
-                     std::uint64_t rate_events);
+  void publish_stats(const CameraSummary& summary, const DecodeCounts& decoded, const DropCounts& drops,
+                     double period_s, std::uint64_t rate_events);
 
   lcm::LCM& lcm_;
   CameraNodeOptions options_;
   std::int64_t epoch_us_;
   std::string channel_;
-  event_batch_t header_;             // header fields of the next batch (its arrays stay empty)
-  std::vector<std::uint8_t> wire_;   // the encoded batch, reused
+  event_batch_t header_;            // header fields of the next batch (its arrays stay empty)
+  std::vector<std::uint8_t> wire_;  // the encoded batch, reused
   std::optional<Timestamp> first_published_t_;
-  SensorLag sensor_lag_;             // of the live source being published
+  SensorLag sensor_lag_;  // of the live source being published
 };
 
 }  // namespace evldt

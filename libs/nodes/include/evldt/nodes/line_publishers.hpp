@@ -17,11 +17,11 @@
 #include <string>
 #include <vector>
 
-#include "evldt/pipeline/realtime_engine.hpp"
-#include "evldt/pipeline/whole_line_stage.hpp"
+#include "evldt/camera_info_t.hpp"
 #include "evldt/nodes/lines_ingest.hpp"
 #include "evldt/nodes/lines_options.hpp"
-#include "evldt/camera_info_t.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
+#include "evldt/pipeline/whole_line_stage.hpp"
 #include "evldt/segment_list_t.hpp"
 
 namespace evldt {
@@ -40,13 +40,15 @@ class WholeLinePublisher {
   WholeLinePublisher(lcm::LCM& lcm, const LinesNodeOptions& options, std::int64_t epoch_us, std::uint64_t first_id);
 
   /// Hands over the lines of the segment list just sent, replacing a step not begun yet.
-  void hand_over(const std::shared_ptr<RealtimeEngine>& engine, std::span<const TrackedLine> lines, const ListHeader& header,
-                 bool shedding);
+  void hand_over(const std::shared_ptr<RealtimeEngine>& engine, std::span<const TrackedLine> lines,
+                 const ListHeader& header, bool shedding);
   /// The whole-line thread: publishes each step handed over until `stop` (checked every 100 ms).
   void loop(const std::atomic<bool>& stop);
 
   [[nodiscard]] std::uint64_t published() const { return published_.load(std::memory_order_relaxed); }
-  [[nodiscard]] std::uint64_t published_while_shedding() const { return while_shedding_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t published_while_shedding() const {
+    return while_shedding_.load(std::memory_order_relaxed);
+  }
 
  private:
   struct Step {
@@ -134,7 +136,8 @@ class CameraInfoPublisher {
 };
 
 /// The list header's fields of a segment_list_t.
-void fill_header(const ListHeader& header, std::int64_t epoch_us, const std::string& camera, std::int64_t seq, segment_list_t& msg);
+void fill_header(const ListHeader& header, std::int64_t epoch_us, const std::string& camera, std::int64_t seq,
+                 segment_list_t& msg);
 
 /// A rate's period on the steady clock.
 std::chrono::steady_clock::duration period_of(double hz);

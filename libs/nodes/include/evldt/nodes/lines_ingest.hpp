@@ -12,8 +12,8 @@
 #include <mutex>
 #include <span>
 
-#include "evldt/pipeline/realtime_engine.hpp"
 #include "evldt/nodes/lines_options.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
 #include "evldt/transport/payload_queue.hpp"
 
 namespace evldt {
@@ -61,8 +61,9 @@ class LinesIngest {
   EventBatchReceiver receiver_;
   LatencyBudget budget_;
   EventBatch batch_;
-  std::shared_ptr<RealtimeEngine> prebuilt_;  ///< built and started at start for a configured sensor, for the first batch
-  std::uint64_t sizes_refused_ = 0;           ///< batches of a sensor size the configuration refused
+  std::shared_ptr<RealtimeEngine>
+      prebuilt_;                     ///< built and started at start for a configured sensor, for the first batch
+  std::uint64_t sizes_refused_ = 0;  ///< batches of a sensor size the configuration refused
 
   mutable std::mutex mutex_;  // guards the members below (the storing thread alone writes them)
   std::uint64_t next_line_id_;

@@ -5,13 +5,13 @@
 // the statistics on the publishing thread, the whole-line publisher on its own
 // (line_publishers.hpp, lines_statistics.hpp).
 
+#include <sys/types.h>
 #include <atomic>
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-#include <sys/types.h>
 
 #include "evldt/nodes/line_publishers.hpp"
 #include "evldt/nodes/lines_ingest.hpp"

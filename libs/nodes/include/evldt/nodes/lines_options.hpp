@@ -42,7 +42,7 @@ struct LinesNodeOptions {
 
 /// Totals since start (what the stats message and the exit summary report).
 struct LinesNodeTotals {
-  ReceiverCounts receiver;           ///< batches received, lost, invalid and shed
+  ReceiverCounts receiver;            ///< batches received, lost, invalid and shed
   std::uint64_t events_received = 0;  ///< valid events handed to the engine
   FilterCounts filtered;              ///< what the noise filters dropped of them
   std::uint64_t events_stored = 0;
@@ -54,9 +54,9 @@ struct LinesNodeTotals {
   std::uint64_t lists_published = 0;
   std::uint64_t whole_lists_published = 0;
   std::uint64_t whole_lists_while_shedding = 0;  ///< of them, published at whole_lines_loaded_hz
-  std::uint64_t engine_restarts = 0;  ///< the camera restarted (new epoch): the lattice began afresh
-  LatencySummary latency;             ///< batch publish -> first list including it, since the last camera (re)start
-  LatencySummary settled_latency;     ///< the same, of the batches published 1 s or more after the first (LatencyTracker)
+  std::uint64_t engine_restarts = 0;             ///< the camera restarted (new epoch): the lattice began afresh
+  LatencySummary latency;          ///< batch publish -> first list including it, since the last camera (re)start
+  LatencySummary settled_latency;  ///< the same, of the batches published 1 s or more after the first (LatencyTracker)
   /// Batches whose latency was measured from their receipt: their publish stamps were far from this
   /// host's clock (LatencyTracker::kClocksApartUs), by publish_clock_offset_us.
   std::uint64_t latency_from_receipt = 0;

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 
-#include "evldt/pipeline/realtime_engine.hpp"
 #include "evldt/nodes/lines_options.hpp"
+#include "evldt/pipeline/realtime_engine.hpp"
 
 namespace evldt {
 
@@ -18,8 +18,8 @@ class LinesStatistics {
   /// Publishes the figures of the last period_s: `now` the totals, `latency` that of the lists of
   /// the period, `live_lines` in the last list, `engine` (nullptr before the first batch) for the
   /// filters and the masked pixels.
-  void publish(const LinesNodeTotals& now, const LatencySummary& latency, std::size_t live_lines, const RealtimeEngine* engine,
-               double period_s);
+  void publish(const LinesNodeTotals& now, const LatencySummary& latency, std::size_t live_lines,
+               const RealtimeEngine* engine, double period_s);
   /// The log's status line of `now`, with the latency of the last statistics period.
   void log(const LinesNodeTotals& now) const;
 

@@ -4,16 +4,16 @@
 // renders frames at a set rate (surface, segments coloured by status, a status line).
 
 #include <atomic>
-#include <cstdio>
 #include <chrono>
+#include <cstdio>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <optional>
 #include <string>
 
 #include "evldt/pipeline/pipeline_config.hpp"
-#include "evldt/render/scene_renderer.hpp"
 #include "evldt/render/line_picture.hpp"
+#include "evldt/render/scene_renderer.hpp"
 #include "evldt/scarf/scarf_lattice.hpp"
 #include "evldt/transport/event_batch_receiver.hpp"
 
@@ -49,10 +49,10 @@ class VizNode {
   VizNode(const VizNode&) = delete;
   VizNode& operator=(const VizNode&) = delete;
 
-  /// Receives until `stop` is set (or the handler says stop), handing a frame to `on_frame` render_hz times a second once the
-  /// first event batch has arrived; every message received before a frame is due is in it. After a stop, handles what
-  /// has already arrived (for at most kStopDrain) so that the totals count it. Everything runs on the calling thread
-  /// (window toolkits need it).
+  /// Receives until `stop` is set (or the handler says stop), handing a frame to `on_frame` render_hz times a second
+  /// once the first event batch has arrived; every message received before a frame is due is in it. After a stop,
+  /// handles what has already arrived (for at most kStopDrain) so that the totals count it. Everything runs on the
+  /// calling thread (window toolkits need it).
   void run(const std::atomic<bool>& stop, const FrameHandler& on_frame);
   /// A key pressed in the window: toggles a layer of kLayers from the next frame on; false for
   /// other keys. Call from the thread that runs the node (the frame handler).

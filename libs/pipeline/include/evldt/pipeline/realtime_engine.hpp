@@ -30,7 +30,7 @@
 namespace evldt {
 
 struct EngineCounters {
-  FilterCounts filtered;             ///< what the noise filters let through and dropped
+  FilterCounts filtered;              ///< what the noise filters let through and dropped
   std::uint64_t events_received = 0;  ///< handed to process()
   std::uint64_t events = 0;           ///< stored
   std::uint64_t off_rectified = 0;    ///< with a calibration: left out, their pixel feeds no rectified pixel
@@ -111,31 +111,32 @@ class RealtimeEngine {
   bool hand_over_views();
   void take_view(LoopState& loop);  // under lattice_mutex_
   template <typename Round>
-  void loop(const char* thread_name, LoopState& state, std::atomic<std::uint64_t>& rounds, Timestamp period_us, Round round);
+  void loop(const char* thread_name, LoopState& state, std::atomic<std::uint64_t>& rounds, Timestamp period_us,
+            Round round);
 
   PipelineConfig config_;
-  mutable std::mutex intake_mutex_;           // the producer filters under it; counters() reads under it
-  EventIntake intake_;                        // guarded by intake_mutex_
-  ScarfLattice lattice_;                      // guarded by lattice_mutex_
+  mutable std::mutex intake_mutex_;  // the producer filters under it; counters() reads under it
+  EventIntake intake_;               // guarded by intake_mutex_
+  ScarfLattice lattice_;             // guarded by lattice_mutex_
   mutable std::mutex lattice_mutex_;
   std::condition_variable lattice_changed_;
-  std::uint64_t events_stored_ = 0;           // guarded by lattice_mutex_
-  std::uint64_t events_received_ = 0;         // stored or filtered; guarded by lattice_mutex_
-  Timestamp latest_event_us_ = 0;             // guarded by lattice_mutex_
+  std::uint64_t events_stored_ = 0;    // guarded by lattice_mutex_
+  std::uint64_t events_received_ = 0;  // stored or filtered; guarded by lattice_mutex_
+  Timestamp latest_event_us_ = 0;      // guarded by lattice_mutex_
   static constexpr Timestamp kNeverShed = std::numeric_limits<Timestamp>::min();
   // Rounds stay further apart until this much event time has passed without a batch shed.
   static constexpr Timestamp kSheddingMemoryUs = 1'000'000;
-  Timestamp last_overload_us_ = kNeverShed;   // event time of the last batch shed or thinned; guarded by lattice_mutex_
-  bool stopping_ = false;                     // guarded by lattice_mutex_
-  std::atomic<bool> storing_{false};          // process() is running: a loop lets it copy the views
+  Timestamp last_overload_us_ = kNeverShed;  // event time of the last batch shed or thinned; guarded by lattice_mutex_
+  bool stopping_ = false;                    // guarded by lattice_mutex_
+  std::atomic<bool> storing_{false};         // process() is running: a loop lets it copy the views
   LoopState detect_, track_;
 
   mutable std::mutex lines_mutex_;
-  LineMap lines_;                             // guarded by lines_mutex_
-  WorkerPool pool_;                           // config.threads: the loops take turns with it
-  LineDetector detector_;                     // used only under lines_mutex_
-  LineTracker tracker_;                       // used only under lines_mutex_
-  Timestamp lines_time_us_ = 0;               // guarded by lines_mutex_
+  LineMap lines_;                                // guarded by lines_mutex_
+  WorkerPool pool_;                              // config.threads: the loops take turns with it
+  LineDetector detector_;                        // used only under lines_mutex_
+  LineTracker tracker_;                          // used only under lines_mutex_
+  Timestamp lines_time_us_ = 0;                  // guarded by lines_mutex_
   std::atomic<std::uint64_t> lines_version_{0};  // written under lines_mutex_
   mutable std::condition_variable round_done_;   // with lines_mutex_
 

@@ -7,8 +7,8 @@
 #include <span>
 #include <vector>
 
-#include "evldt/pipeline/pipeline_config.hpp"
 #include "evldt/lines/whole_lines.hpp"
+#include "evldt/pipeline/pipeline_config.hpp"
 
 namespace evldt {
 

@@ -29,12 +29,12 @@ class WorkerPool final : public RoundWorkers {
   std::mutex turn_;  // one run() at a time
   std::mutex mutex_;
   std::condition_variable start_, done_;
-  Erased function_ = nullptr;   // guarded by mutex_
-  void* context_ = nullptr;     // guarded by mutex_
+  Erased function_ = nullptr;     // guarded by mutex_
+  void* context_ = nullptr;       // guarded by mutex_
   std::uint64_t generation_ = 0;  // guarded by mutex_: bumped by every run()
-  bool open_ = false;           // guarded by mutex_: workers may still join this run
-  int running_ = 0;             // guarded by mutex_: workers in this run's task
-  bool stopping_ = false;       // guarded by mutex_
+  bool open_ = false;             // guarded by mutex_: workers may still join this run
+  int running_ = 0;               // guarded by mutex_: workers in this run's task
+  bool stopping_ = false;         // guarded by mutex_
   std::vector<std::thread> threads_;
 };
 

@@ -3,8 +3,8 @@
 // segments coloured by status (detected yellow, good track green, bad track red), and the pixels
 // the hot-pixel filter masks.
 
-#include <opencv2/core.hpp>
 #include <array>
+#include <opencv2/core.hpp>
 #include <span>
 #include <string>
 #include <vector>
@@ -16,16 +16,16 @@ namespace evldt {
 /// What is drawn. The viz toggles each layer with a key (kLayers). By default the whole lines, the
 /// pipeline's best output, are drawn with their ids over thinner segments without ids.
 struct RenderOptions {
-  int scale = 1;                      ///< integer zoom of the output image
-  bool show_events = true;            ///< the SCARF surface
-  bool show_segments = true;          ///< detected and well-tracked segments
-  bool show_bad_tracks = true;        ///< segments whose last track scored below the threshold
-  bool show_whole_lines = true;       ///< whole lines (draw_whole_lines), over the segments
-  bool show_whole_line_ids = true;    ///< each whole line's label beside it
-  bool show_motion = true;            ///< each whole line's motion across itself, an arrow (motion_arrow)
-  bool show_segment_ids = false;      ///< each segment's label beside it
-  bool show_grid = false;             ///< the lattice's block borders
-  int grid_block_size = 0;            ///< spacing of the grid (b); 0: no grid
+  int scale = 1;                    ///< integer zoom of the output image
+  bool show_events = true;          ///< the SCARF surface
+  bool show_segments = true;        ///< detected and well-tracked segments
+  bool show_bad_tracks = true;      ///< segments whose last track scored below the threshold
+  bool show_whole_lines = true;     ///< whole lines (draw_whole_lines), over the segments
+  bool show_whole_line_ids = true;  ///< each whole line's label beside it
+  bool show_motion = true;          ///< each whole line's motion across itself, an arrow (motion_arrow)
+  bool show_segment_ids = false;    ///< each segment's label beside it
+  bool show_grid = false;           ///< the lattice's block borders
+  int grid_block_size = 0;          ///< spacing of the grid (b); 0: no grid
 };
 
 /// A layer a key shows or hides.

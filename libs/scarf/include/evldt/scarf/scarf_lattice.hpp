@@ -130,10 +130,10 @@ class ScarfLattice {
 
  private:
   struct alignas(16) BlockState {
-    std::uint16_t head = 0;    ///< next slot to overwrite
-    std::uint16_t filled = 0;  ///< slots in use (reaches N and stays)
-    std::uint16_t active = 0;  ///< ACTIVE entries among them
-    std::uint64_t version = 0; ///< the change clock when the block last changed
+    std::uint16_t head = 0;     ///< next slot to overwrite
+    std::uint16_t filled = 0;   ///< slots in use (reaches N and stays)
+    std::uint16_t active = 0;   ///< ACTIVE entries among them
+    std::uint64_t version = 0;  ///< the change clock when the block last changed
   };
   /// Per pixel column (row): the block column (row) whose active region holds it, and the one on
   /// the side of the half it lies in, whose extended region also holds it; -1 where there is none.
@@ -166,9 +166,17 @@ class ScarfLattice {
   Rings begin_change() {
     copied_from_ = 0;
     ++change_clock_;
-    return {columns_.data(), rows_.data(), blocks_.data(), arrivals_.data(), entries_.data(), surface_.empty() ? nullptr : surface_.data(),
-            static_cast<std::size_t>(geometry_.sensor.width), geometry_.blocks_x, geometry_.block_size,
-            static_cast<std::uint16_t>(geometry_.capacity), change_clock_};
+    return {columns_.data(),
+            rows_.data(),
+            blocks_.data(),
+            arrivals_.data(),
+            entries_.data(),
+            surface_.empty() ? nullptr : surface_.data(),
+            static_cast<std::size_t>(geometry_.sensor.width),
+            geometry_.blocks_x,
+            geometry_.block_size,
+            static_cast<std::uint16_t>(geometry_.capacity),
+            change_clock_};
   }
 
   /// Pushes the event, `copies` times, into each block that holds it: an event's blocks are
@@ -177,16 +185,21 @@ class ScarfLattice {
   static void insert_event(const Rings& rings, std::uint16_t x, std::uint16_t y, int copies = 1) {
     const AxisBlocks column = rings.columns[x];
     const AxisBlocks row = rings.rows[y];
-    if ((column.home | row.home) >= 0) push<kSurface, true>(rings, row.home + column.home, column.home_bits | row.home_bits, x, y, copies);
-    if ((column.side | row.home) >= 0) push<kSurface, false>(rings, row.home + column.side, column.side_bits | row.home_bits, x, y, copies);
-    if ((column.home | row.side) >= 0) push<kSurface, false>(rings, row.side + column.home, column.home_bits | row.side_bits, x, y, copies);
-    if ((column.side | row.side) >= 0) push<kSurface, false>(rings, row.side + column.side, column.side_bits | row.side_bits, x, y, copies);
+    if ((column.home | row.home) >= 0)
+      push<kSurface, true>(rings, row.home + column.home, column.home_bits | row.home_bits, x, y, copies);
+    if ((column.side | row.home) >= 0)
+      push<kSurface, false>(rings, row.home + column.side, column.side_bits | row.home_bits, x, y, copies);
+    if ((column.home | row.side) >= 0)
+      push<kSurface, false>(rings, row.side + column.home, column.home_bits | row.side_bits, x, y, copies);
+    if ((column.side | row.side) >= 0)
+      push<kSurface, false>(rings, row.side + column.side, column.side_bits | row.side_bits, x, y, copies);
   }
 
   // Branch-free bookkeeping: whether the overwritten entry was active is data (about a third of
   // entries are), and a branch on it mispredicts. The block's state stays in registers over the copies.
   template <bool kSurface, bool kActive>
-  static void push(const Rings& rings, std::int32_t block, std::uint16_t place_bits, std::uint16_t x, std::uint16_t y, int copies) {
+  static void push(const Rings& rings, std::int32_t block, std::uint16_t place_bits, std::uint16_t x, std::uint16_t y,
+                   int copies) {
     BlockState state = rings.blocks[block];
     LatticeEntry* const ring = rings.entries + static_cast<std::size_t>(block) * rings.capacity;
     const LatticeEntry entry{static_cast<std::uint16_t>(kActive ? place_bits | LatticeEntry::kActiveBit : place_bits)};

@@ -18,15 +18,15 @@
 namespace evldt {
 
 struct SimulatorConfig {
-  double contrast_on = 0.2;        ///< C+ (log intensity)
-  double contrast_off = 0.2;       ///< C-
-  double contrast_sigma = 0.03;    ///< per-pixel spread of both thresholds (std dev, absolute)
-  Timestamp refractory_us = 100;   ///< a pixel's events closer than this to its previous one are lost
-  double noise_rate_hz = 0.1;      ///< background events per pixel per second
-  double dark_noise_hz = 0;        ///< more background events per pixel per second, times (1 - brightness)
-  int hot_pixels = 0;              ///< pixels that fire at hot_rate_hz regardless of the scene
+  double contrast_on = 0.2;       ///< C+ (log intensity)
+  double contrast_off = 0.2;      ///< C-
+  double contrast_sigma = 0.03;   ///< per-pixel spread of both thresholds (std dev, absolute)
+  Timestamp refractory_us = 100;  ///< a pixel's events closer than this to its previous one are lost
+  double noise_rate_hz = 0.1;     ///< background events per pixel per second
+  double dark_noise_hz = 0;       ///< more background events per pixel per second, times (1 - brightness)
+  int hot_pixels = 0;             ///< pixels that fire at hot_rate_hz regardless of the scene
   double hot_rate_hz = 2000;
-  double max_step_px = 0.5;        ///< largest vertex motion between two rendered sub-frames
+  double max_step_px = 0.5;  ///< largest vertex motion between two rendered sub-frames
   Timestamp max_step_us = 1000;
   /// Readout: events leave the sensor at most this many per second, in time order, stamped when
   /// they leave (0: no limit); an event that would wait longer than readout_queue_us is lost.
@@ -87,8 +87,8 @@ class EventSimulator {
   SimulatorConfig config_;
   SimRandom random_;
   int width_, height_;
-  Timestamp now_ = 0;        // events up to here have been handed out
-  Timestamp rendered_ = 0;   // time of the newest rendered sub-frame
+  Timestamp now_ = 0;       // events up to here have been handed out
+  Timestamp rendered_ = 0;  // time of the newest rendered sub-frame
   std::vector<float> log_prev_, log_now_, log_reference_;
   mutable std::vector<float> lens_canvas_;  // with a lens: the scene rendered rectified, then sampled per pixel
   std::vector<float> threshold_on_, threshold_off_;

@@ -16,11 +16,11 @@
 namespace evldt {
 
 struct FrameDifferenceConfig {
-  double contrast_on = 0.2;      ///< C+ (log intensity)
-  double contrast_off = 0.2;     ///< C-
-  double contrast_sigma = 0.03;  ///< per-pixel spread of both thresholds (std dev); thresholds are clamped to >= 0.01
-  Timestamp refractory_us = 100; ///< a pixel's events closer than this to its previous one are lost
-  double log_offset = 1.0;       ///< log(I + log_offset) on 8-bit intensities, so black is finite
+  double contrast_on = 0.2;       ///< C+ (log intensity)
+  double contrast_off = 0.2;      ///< C-
+  double contrast_sigma = 0.03;   ///< per-pixel spread of both thresholds (std dev); thresholds are clamped to >= 0.01
+  Timestamp refractory_us = 100;  ///< a pixel's events closer than this to its previous one are lost
+  double log_offset = 1.0;        ///< log(I + log_offset) on 8-bit intensities, so black is finite
   std::uint64_t seed = 1;
 };
 

@@ -62,14 +62,15 @@ std::unique_ptr<EventSource> open_dv_stream(std::unique_ptr<ByteSource> bytes);
 /// (header, then data); between attempts it waits, without using the CPU, 0.1 s doubling up to
 /// 2 s. Connects before it returns; ends only when `stop` is set (throws std::runtime_error if
 /// stopped before the first connection).
-std::unique_ptr<EventSource> open_reconnecting(std::function<std::unique_ptr<EventSource>()> open, const std::atomic<bool>& stop);
+std::unique_ptr<EventSource> open_reconnecting(std::function<std::unique_ptr<EventSource>()> open,
+                                               const std::atomic<bool>& stop);
 /// A scene run through the event simulator; `label` names it in logs.
 std::unique_ptr<EventSource> open_scene(Scene scene, const SimulatorConfig& config, const std::string& label);
 
 struct VideoSourceOptions {
-  std::string input;              ///< a video file, or a webcam index ("0")
+  std::string input;  ///< a video file, or a webcam index ("0")
   FrameDifferenceConfig emulator;
-  double fps_override = 0;        ///< frame rate to assume where the file does not say (0: ask the file, else 30)
+  double fps_override = 0;  ///< frame rate to assume where the file does not say (0: ask the file, else 30)
 };
 /// Frames of a video file or webcam, as events by frame differencing. Throws std::runtime_error if
 /// it cannot be opened. A file's frame times come from its frame rate (deterministic); a webcam's

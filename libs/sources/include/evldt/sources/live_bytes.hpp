@@ -69,7 +69,8 @@ class UnixSocketBytes final : public DescriptorBytes {
 /// file under the name) is an error: std::runtime_error, naming it.
 class FollowedFileBytes final : public ByteSource {
  public:
-  FollowedFileBytes(const std::filesystem::path& path, std::chrono::duration<double> idle, const std::atomic<bool>& stop);
+  FollowedFileBytes(const std::filesystem::path& path, std::chrono::duration<double> idle,
+                    const std::atomic<bool>& stop);
   ~FollowedFileBytes() override;
   FollowedFileBytes(const FollowedFileBytes&) = delete;
   FollowedFileBytes& operator=(const FollowedFileBytes&) = delete;

@@ -21,10 +21,10 @@ namespace evldt {
 class ReadAhead {
  public:
   struct Item {
-    EventBatch batch;            ///< as read, then as `prepare` left it
-    EventBatch prepared;         ///< what `prepare` made of it
+    EventBatch batch;               ///< as read, then as `prepare` left it
+    EventBatch prepared;            ///< what `prepare` made of it
     std::uint64_t events_read = 0;  ///< the batch's size as read, before `prepare`
-    double progress = 0;         ///< the source's, after reading it
+    double progress = 0;            ///< the source's, after reading it
   };
   /// Runs on the reading thread for each batch read.
   using Prepare = std::function<void(EventBatch& batch, EventBatch& prepared)>;

@@ -18,10 +18,10 @@ namespace evldt {
 struct ReceiverCounts {
   std::uint64_t invalid_messages = 0;  ///< undecodable (time base out of range included), foreign type, bad sensor size
   SequenceCounts sequence;
-  DropCounts drops;                    ///< events refused by the validator (before a restart included)
-  std::uint64_t batches_shed = 0;      ///< valid, current batches that came later than the latency budget
-  std::uint64_t batches_thinned = 0;   ///< valid, current batches that queued, of which only a share was decoded
-  std::uint64_t events_shed = 0;       ///< events of both not decoded nor validated (shed or thinned out)
+  DropCounts drops;                   ///< events refused by the validator (before a restart included)
+  std::uint64_t batches_shed = 0;     ///< valid, current batches that came later than the latency budget
+  std::uint64_t batches_thinned = 0;  ///< valid, current batches that queued, of which only a share was decoded
+  std::uint64_t events_shed = 0;      ///< events of both not decoded nor validated (shed or thinned out)
 };
 
 class EventBatchReceiver {

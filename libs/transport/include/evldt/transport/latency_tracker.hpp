@@ -49,11 +49,12 @@ class LatencyTracker {
 
   /// A batch was stored: its sequence number, publish wall clock (the sender's), receipt wall clock
   /// (ours) and newest event time.
-  void batch_stored(std::int64_t seq, std::int64_t publish_utime, std::int64_t received_utime, Timestamp newest_event_us);
+  void batch_stored(std::int64_t seq, std::int64_t publish_utime, std::int64_t received_utime,
+                    Timestamp newest_event_us);
 
   struct Included {
-    std::int64_t seq = -1;    ///< newest batch included so far (-1: none yet)
-    std::int64_t utime = 0;   ///< its publish wall clock
+    std::int64_t seq = -1;   ///< newest batch included so far (-1: none yet)
+    std::int64_t utime = 0;  ///< its publish wall clock
   };
   /// A segment list of lattice time `lattice_us` is published at `now_utime`: records the latency
   /// of every waiting batch it includes and returns the newest batch included so far.
@@ -88,7 +89,7 @@ class LatencyTracker {
   std::vector<Pending> ring_;
   std::size_t head_ = 0, count_ = 0;
   LatencyStatistics statistics_;
-  LatencyStatistics settled_{0};  // a run histogram only: its per-period samples are never taken
+  LatencyStatistics settled_{0};             // a run histogram only: its per-period samples are never taken
   std::optional<std::int64_t> first_utime_;  // publish wall clock of the first batch stored
   Included newest_;
   // The least delay of the current window (by receipt time) and of the one before it.

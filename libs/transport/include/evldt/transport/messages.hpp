@@ -9,13 +9,13 @@
 #include <string_view>
 #include <vector>
 
+#include "evldt/calibration/rectifier.hpp"
+#include "evldt/camera_info_t.hpp"
+#include "evldt/event_batch_t.hpp"
 #include "evldt/events/event.hpp"
 #include "evldt/lines/line_types.hpp"
-#include "evldt/event_batch_t.hpp"
 #include "evldt/segment_list_t.hpp"
 #include "evldt/stats_t.hpp"
-#include "evldt/camera_info_t.hpp"
-#include "evldt/calibration/rectifier.hpp"
 
 namespace evldt {
 
@@ -51,7 +51,8 @@ WireError decode_event_batch(std::span<const std::uint8_t> bytes, event_batch_t&
 /// Checks `bytes` as decode_event_batch does and sets the scalar fields of `header`, without decoding
 /// the events: `last_event_us` is the time of the batch's last event (its time base if it has none).
 /// What a subscriber needs to account a batch it sheds unread.
-WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_batch_t& header, Timestamp& last_event_us);
+WireError decode_event_batch_header(std::span<const std::uint8_t> bytes, event_batch_t& header,
+                                    Timestamp& last_event_us);
 
 /// Fills the segments of `msg` (header fields are the caller's).
 void fill_segment_list(std::span<const TrackedLine> lines, segment_list_t& msg);

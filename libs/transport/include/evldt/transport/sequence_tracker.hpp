@@ -10,10 +10,10 @@ namespace evldt {
 
 struct SequenceCounts {
   std::uint64_t received = 0;
-  std::uint64_t lost = 0;          ///< sequence numbers skipped
-  std::uint64_t late = 0;          ///< duplicates, out of order, or from an older epoch (not used)
-  std::uint64_t restarts = 0;      ///< publisher epochs seen after the first, resyncs included
-  std::uint64_t resyncs = 0;       ///< runs of late messages after which their stream was followed
+  std::uint64_t lost = 0;      ///< sequence numbers skipped
+  std::uint64_t late = 0;      ///< duplicates, out of order, or from an older epoch (not used)
+  std::uint64_t restarts = 0;  ///< publisher epochs seen after the first, resyncs included
+  std::uint64_t resyncs = 0;   ///< runs of late messages after which their stream was followed
 };
 
 /// Consecutive late messages after which the tracker follows their stream: 0.1 s of 1 kHz batches.

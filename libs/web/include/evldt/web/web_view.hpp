@@ -13,10 +13,10 @@
 // number, status lines, layers), POST /key/K (a layer's key, as pressed in a window).
 
 #include <atomic>
-#include <cstdio>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <mutex>
 #include <opencv2/core.hpp>
