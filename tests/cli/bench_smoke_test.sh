@@ -12,8 +12,12 @@ for key in storage_mev_s receive_mev_s detect_hz track_hz filters_mev_s rectify_
   value=$(grep -oP "\"$key\": \K[0-9.e+-]+" "$work/bench.json")
   awk -v v="$value" 'BEGIN { exit !(v > 0) }' || { echo "FAILED: $key = '$value'"; exit 1; }
 done
-setup_ms=$(grep -oP '"filters_setup_ms": \{"unit": "ms", "median": \K[0-9.e+-]+' "$work/bench.json")
-awk -v v="$setup_ms" 'BEGIN { exit !(v > 0) }' || { echo "FAILED: filters_setup_ms = '$setup_ms'"; exit 1; }
+for timing in filters_setup_ms storage_by_block_ns_per_event storage_bound_ns_per_event filters_bound_ns_per_event; do
+  value=$(grep -oP "\"$timing\": \\{\"unit\": \"[a-z]+\", \"median\": \K[0-9.e+-]+" "$work/bench.json")
+  awk -v v="$value" 'BEGIN { exit !(v > 0) }' || { echo "FAILED: $timing = '$value'"; exit 1; }
+done
+# The per-event path against its memory bound: a row of nine positive figures.
+grep -qP '^240x180( +[0-9]+\.[0-9]+){9}$' "$work/out.txt" || { echo "FAILED: per-event path table"; exit 1; }
 # Decoding speed: the same events in each of the five file formats, every one read whole.
 "$1" --decode --repeats 1 >"$work/decode.txt"
 cat "$work/decode.txt"

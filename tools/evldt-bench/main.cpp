@@ -2,7 +2,10 @@
 // sensor size, on one core (--threads N: the detection and tracking passes and the pipeline's rounds
 // on a pool of N). For each size a built-in scene is simulated (the first --window-ms), and each
 // figure is the median of --repeats timed repeats, each repeat long enough (--min-time-ms) for the
-// clock not to matter.
+// clock not to matter. A second table sets the per-event path (receive, filters, storage) against
+// what memory allows: plain writes with the same access pattern and none of the work, the filters'
+// (of the default chain's tables) prefetched as the chain prefetches; and storage with each message
+// first sorted by home block.
 // Every size runs in a child process of its own, so its peak RSS is its own.
 
 #include <sys/wait.h>
@@ -59,6 +62,8 @@ struct Figures {
   double scene_rate_mev_s = 0;  ///< their rate in the scene
   Timing storage;               ///< per event
   Timing storage_aos;           ///< per event, from an array of Event structs
+  Timing storage_by_block;      ///< per event, each message sorted by home block, then stored
+  Timing storage_bound;         ///< per event, a plain ring write into each of its blocks
   Timing receive;               ///< per event: an LCM event batch decoded, checked and validated
   Timing detect;                ///< per pass, every block free
   double active_points = 0;     ///< active entries in the lattice the passes see
@@ -71,6 +76,7 @@ struct Figures {
   Timing snapshot_1ms;         ///< per update of a view after 1 ms of the scene's events
   Timing filters;              ///< per event, the default noise filters from an empty state
   Timing filters_setup;        ///< per chain: building the filters' empty state (a service does it once, at start)
+  Timing filters_bound;        ///< per event, a plain touch of the lines the default chain's tests touch
   Timing rectify;              ///< per event, moving it into the rectified image of a calibrated camera
   Timing pipeline;             ///< per event, the whole deterministic pipeline from an empty state
   Timing pipeline_unfiltered;  ///< the same without the noise filters
@@ -172,6 +178,112 @@ Timing time_receive(const BenchSettings& settings, SensorSize sensor, const Even
   });
 }
 
+/// Where an axis's pixel is stored: the block whose active region holds it and the one on the side
+/// of the half it lies in (as ScarfLattice places it); -1 where there is none.
+std::pair<int, int> blocks_along(int pixel, int block_size, int blocks) {
+  const int half = block_size / 2;
+  const int shifted = pixel - half;
+  const int home = shifted >= 0 ? shifted / block_size : -1;
+  const int side = shifted - home * block_size < half ? home - 1 : home + 1;
+  return {home < blocks ? home : -1, side >= 0 && side < blocks ? side : -1};
+}
+
+/// The memory bound of storage: each event written at the head of every ring that holds it, with
+/// the lattice's access pattern and none of its bookkeeping (the rings of those blocks are listed
+/// before timing; an event's missing blocks write into one spare ring).
+Timing time_ring_writes(const EventBatch& events, const LatticeGeometry& geometry, const BenchSettings& settings) {
+  const auto spare = static_cast<std::uint32_t>(geometry.block_count());
+  std::vector<std::uint32_t> blocks;
+  blocks.reserve(4 * events.size());
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const auto [home_x, side_x] = blocks_along(events.x[i], geometry.block_size, geometry.blocks_x);
+    const auto [home_y, side_y] = blocks_along(events.y[i], geometry.block_size, geometry.blocks_y);
+    for (const int row : {home_y, side_y}) {
+      for (const int column : {home_x, side_x}) {
+        blocks.push_back(row >= 0 && column >= 0 ? static_cast<std::uint32_t>(geometry.index(column, row)) : spare);
+      }
+    }
+  }
+  const auto capacity = static_cast<std::size_t>(geometry.capacity);
+  std::vector<LatticeEntry> rings((spare + 1) * capacity);
+  std::vector<std::uint16_t> heads(spare + 1);
+  return time_op(settings, [&] {
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      const std::uint32_t block = blocks[k];
+      std::uint16_t& head = heads[block];
+      rings[block * capacity + head] = LatticeEntry{static_cast<std::uint16_t>(k)};
+      head = static_cast<std::uint16_t>(head + 1u == capacity ? 0u : head + 1u);
+    }
+  });
+}
+
+/// Storage by place: each message's events listed by home block (a stable counting sort, so each
+/// block's in time order), then stored in that order.
+void store_by_block(const EventBatch& events, ScarfLattice& lattice) {
+  const LatticeGeometry& geometry = lattice.geometry();
+  static thread_local std::vector<std::uint32_t> starts, block_of;
+  static thread_local std::vector<std::uint16_t> xs, ys;
+  starts.assign(static_cast<std::size_t>(geometry.block_count()) + 2, 0);
+  for (std::size_t begin = 0; begin < events.size(); begin += kEventsPerMessage) {
+    const std::size_t count = std::min(kEventsPerMessage, events.size() - begin);
+    block_of.resize(count);
+    xs.resize(count);
+    ys.resize(count);
+    std::fill(starts.begin(), starts.end(), 0u);
+    for (std::size_t i = 0; i < count; ++i) {
+      // Events in no block's active region (the margins) go last.
+      const int block = geometry.block_at(static_cast<float>(events.x[begin + i]) + 0.5f,
+                                          static_cast<float>(events.y[begin + i]) + 0.5f);
+      block_of[i] = block >= 0 ? static_cast<std::uint32_t>(block) : static_cast<std::uint32_t>(geometry.block_count());
+      ++starts[block_of[i] + 1];
+    }
+    for (std::size_t b = 1; b < starts.size(); ++b) starts[b] += starts[b - 1];
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint32_t at = starts[block_of[i]]++;
+      xs[at] = events.x[begin + i];
+      ys[at] = events.y[begin + i];
+    }
+    lattice.insert(xs, ys);
+  }
+}
+
+/// The memory bound of the default filters: per event, one plain read or write of each cell their
+/// tests read (its pixel's 32-byte record, its count, and the 3 x 3 cells of the background
+/// surface), in tables of their sizes, with none of their logic.
+Timing time_filter_touches(const std::vector<EventBatch>& messages, SensorSize sensor, const BenchSettings& settings) {
+  const auto width = static_cast<std::size_t>(sensor.width), height = static_cast<std::size_t>(sensor.height);
+  const std::size_t stride = width + 2;
+  std::vector<PixelState> records(width * height);
+  std::vector<std::uint32_t> counts(width * height), surface(stride * (height + 2));
+  volatile std::uint32_t kept_reads = 0;  // so the reads are made
+  const Timing timing = time_op(settings, [&] {
+    std::uint32_t seen = 0;
+    for (const EventBatch& message : messages) {
+      for (std::size_t i = 0; i < message.size(); ++i) {
+        if (i + 16 < message.size()) {  // as the chain prefetches
+          const std::size_t ax = message.x[i + 16], ay = message.y[i + 16];
+          __builtin_prefetch(&records[ay * width + ax], 1);
+          __builtin_prefetch(&counts[ay * width + ax], 1);
+          for (std::size_t row = 0; row < 3; ++row) {
+            __builtin_prefetch(&surface[(ay + row) * stride + ax], 1);
+            __builtin_prefetch(&surface[(ay + row) * stride + ax + 2], 1);
+          }
+        }
+        const std::size_t x = message.x[i], y = message.y[i], pixel = y * width + x;
+        const auto t = static_cast<std::uint32_t>(message.t[i]);
+        records[pixel].refractory = t;
+        ++counts[pixel];
+        const std::uint32_t* const above = surface.data() + y * stride + x;
+        seen += above[0] + above[1] + above[2] + above[2 * stride] + above[2 * stride + 1] + above[2 * stride + 2] +
+                above[stride] + above[stride + 2];
+        surface[(y + 1) * stride + x + 1] = t;
+      }
+    }
+    kept_reads = seen;
+  });
+  return timing;
+}
+
 /// Storing events in the lattice, from the batch's columns and from an array of structs.
 void measure_storage(const EventBatch& events, const PipelineConfig& config, const BenchSettings& settings,
                      Figures& f) {
@@ -187,6 +299,8 @@ void measure_storage(const EventBatch& events, const PipelineConfig& config, con
                                      for (const Event& e : structs) lattice.insert(e.x, e.y);
                                    }),
                            n);
+  f.storage_by_block = per_item(time_op(settings, [&] { store_by_block(events, lattice); }), n);
+  f.storage_bound = per_item(time_ring_writes(events, lattice.geometry(), settings), n);
 }
 
 /// A detection pass with every block free, on the lattice at the window's end.
@@ -296,6 +410,7 @@ void measure_intake(const std::vector<EventBatch>& messages, const PipelineConfi
   }
   f.filters_setup = median_timing(setup_seconds);
   f.filters = per_item(median_timing(filter_seconds), n);
+  f.filters_bound = per_item(time_filter_touches(messages, sensor, settings), n);
   // Rectification of a calibrated camera: a barrel lens as strong as the DAVIS240C's, scaled to
   // the sensor (the table is made once, at start; each event costs a lookup).
   CameraModel lens;
@@ -427,6 +542,21 @@ void print_row(const SizeCase& c, const Figures& f) {
   std::fflush(stdout);
 }
 
+/// The per-event path before any round, against what memory allows (the plain writes with its
+/// access pattern).
+void print_event_path(const std::vector<std::pair<SizeCase, Figures>>& results) {
+  std::printf("\nper-event path, ns an event (medians); bound: plain writes with the same access pattern\n");
+  std::printf("%-9s %8s %8s %8s %7s %8s %9s %8s %7s %8s\n", "size", "receive", "filters", "(bound)", "ratio", "storage",
+              "by block", "(bound)", "ratio", "path");
+  for (const auto& [c, f] : results) {
+    const double receive = f.receive.median * 1e9, filters = f.filters.median * 1e9, storage = f.storage.median * 1e9;
+    std::printf("%-9s %8.1f %8.1f %8.1f %7.2f %8.1f %9.1f %8.1f %7.2f %8.1f\n", c.label, receive, filters,
+                f.filters_bound.median * 1e9, f.filters.median / f.filters_bound.median, storage,
+                f.storage_by_block.median * 1e9, f.storage_bound.median * 1e9,
+                f.storage.median / f.storage_bound.median, receive + filters + storage);
+  }
+}
+
 void write_timing(std::ofstream& out, const char* name, Timing t, const char* unit, double scale) {
   out << "      \"" << name << "\": {\"unit\": \"" << unit << "\", \"median\": " << t.median * scale
       << ", \"min\": " << t.min * scale << ", \"max\": " << t.max * scale << "},\n";
@@ -445,6 +575,8 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
         << "      \"events\": " << f.events << ",\n      \"scene_rate_mev_s\": " << f.scene_rate_mev_s << ",\n";
     write_timing(out, "storage_ns_per_event", f.storage, "ns", 1e9);
     write_timing(out, "storage_aos_ns_per_event", f.storage_aos, "ns", 1e9);
+    write_timing(out, "storage_by_block_ns_per_event", f.storage_by_block, "ns", 1e9);
+    write_timing(out, "storage_bound_ns_per_event", f.storage_bound, "ns", 1e9);
     write_timing(out, "receive_ns_per_event", f.receive, "ns", 1e9);
     write_timing(out, "detect_pass_us", f.detect, "us", 1e6);
     write_timing(out, "track_pass_us", f.track, "us", 1e6);
@@ -453,6 +585,7 @@ void write_json(const std::filesystem::path& path, const BenchSettings& settings
     write_timing(out, "snapshot_after_1ms_us", f.snapshot_1ms, "us", 1e6);
     write_timing(out, "filters_ns_per_event", f.filters, "ns", 1e9);
     write_timing(out, "filters_setup_ms", f.filters_setup, "ms", 1e3);
+    write_timing(out, "filters_bound_ns_per_event", f.filters_bound, "ns", 1e9);
     write_timing(out, "rectify_ns_per_event", f.rectify, "ns", 1e9);
     write_timing(out, "pipeline_ns_per_event", f.pipeline, "ns", 1e9);
     write_timing(out, "pipeline_unfiltered_ns_per_event", f.pipeline_unfiltered, "ns", 1e9);
@@ -587,6 +720,7 @@ int main(int argc, char** argv) {
         failed = true;
       }
     }
+    print_event_path(results);
     if (!json_path.empty()) {
       write_json(json_path, settings, results);
       std::printf("wrote %s\n", json_path.string().c_str());
