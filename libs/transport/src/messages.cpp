@@ -272,13 +272,19 @@ WireError decode_event_batch_into(std::span<const std::uint8_t> bytes, event_bat
   events.y.resize(kept);
   events.p.resize(kept);
   const Timestamp t_base = header.t_base_us;
+  // The columns as plain pointers: a store through the vectors' own (of int8_t, which may alias
+  // anything) would make the compiler reload their pointers at every event and not vectorise.
+  Timestamp* const out_t = events.t.data();
+  std::uint16_t* const out_x = events.x.data();
+  std::uint16_t* const out_y = events.y.data();
+  std::int8_t* const out_p = events.p.data();
   const auto decode = [&](auto step) {  // a constant step of 1 keeps the loops vectorised
     for (std::size_t k = 0; k < kept; ++k)
-      events.t[k] = t_base + static_cast<std::int32_t>(get_be32(dt + 4 * (first + k * step)));
+      out_t[k] = t_base + static_cast<std::int32_t>(get_be32(dt + 4 * (first + k * step)));
     // Negative coordinates arrive as 32768..65535: off every sensor, so the validator drops them.
-    for (std::size_t k = 0; k < kept; ++k) events.x[k] = get_be16(xs + 2 * (first + k * step));
-    for (std::size_t k = 0; k < kept; ++k) events.y[k] = get_be16(ys + 2 * (first + k * step));
-    for (std::size_t k = 0; k < kept; ++k) events.p[k] = polarity[first + k * step] ? std::int8_t{1} : std::int8_t{-1};
+    for (std::size_t k = 0; k < kept; ++k) out_x[k] = get_be16(xs + 2 * (first + k * step));
+    for (std::size_t k = 0; k < kept; ++k) out_y[k] = get_be16(ys + 2 * (first + k * step));
+    for (std::size_t k = 0; k < kept; ++k) out_p[k] = polarity[first + k * step] ? std::int8_t{1} : std::int8_t{-1};
   };
   if (stride == 1) {
     decode(std::integral_constant<std::size_t, 1>{});
