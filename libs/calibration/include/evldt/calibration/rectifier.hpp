@@ -61,12 +61,23 @@ class Rectifier {
   /// out. A pixel that feeds several sends its events to each in turn: the rectified edge is held at
   /// every pixel, and no event is counted twice.
   void apply(const EventBatch& in, EventBatch& out) {
-    out.clear();
-    const std::uint32_t* first = table_->first.data();
-    const std::uint32_t* targets = table_->targets.data();
+    const std::size_t n = in.size();
+    out.truncate(n);  // room for every event: no allocation once as large
+    // The columns as plain pointers: the byte stores (turns, polarities) may alias anything, and
+    // through the vectors the compiler would reload their pointers at every event.
+    const Timestamp* const in_t = in.t.data();
+    const std::uint16_t *const in_x = in.x.data(), *const in_y = in.y.data();
+    const std::int8_t* const in_p = in.p.data();
+    Timestamp* const out_t = out.t.data();
+    std::uint16_t *const out_x = out.x.data(), *const out_y = out.y.data();
+    std::int8_t* const out_p = out.p.data();
+    const std::uint32_t* const first = table_->first.data();
+    const std::uint32_t* const targets = table_->targets.data();
+    std::uint8_t* const turns = turn_.data();
     const auto width = static_cast<std::uint32_t>(table_->sensor.width);
-    for (std::size_t i = 0; i < in.size(); ++i) {
-      const std::uint32_t pixel = static_cast<std::uint32_t>(in.y[i]) * width + in.x[i];
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t pixel = static_cast<std::uint32_t>(in_y[i]) * width + in_x[i];
       const std::uint32_t begin = first[pixel], count = first[pixel + 1] - begin;
       if (count == 0) {
         ++dropped_;
@@ -74,13 +85,17 @@ class Rectifier {
       }
       std::uint32_t k = begin;
       if (count > 1) {
-        std::uint8_t& turn = turn_[pixel];
+        std::uint8_t& turn = turns[pixel];
         k += turn % count;
         turn = static_cast<std::uint8_t>(turn + 1);
       }
-      out.push_back(in.t[i], static_cast<std::uint16_t>(targets[k] & 0xFFFFu),
-                    static_cast<std::uint16_t>(targets[k] >> 16), in.p[i]);
+      out_t[kept] = in_t[i];
+      out_x[kept] = static_cast<std::uint16_t>(targets[k] & 0xFFFFu);
+      out_y[kept] = static_cast<std::uint16_t>(targets[k] >> 16);
+      out_p[kept] = in_p[i];
+      ++kept;
     }
+    out.truncate(kept);
   }
   /// Events left out so far: their pixel feeds no rectified pixel.
   [[nodiscard]] std::uint64_t dropped() const { return dropped_; }
