@@ -12,19 +12,10 @@
 #include "evldt/containers/ros_messages.hpp"
 #include "evldt/events/event_decoder.hpp"
 #include "evldt/events/event_format.hpp"
+#include "mcap_records.hpp"
 
 namespace evldt {
 namespace {
-
-// The record types read here (MCAP specification, major version 0); the others are skipped.
-enum Opcode : std::uint8_t {
-  kFooter = 0x02,
-  kSchema = 0x03,
-  kChannel = 0x04,
-  kMessage = 0x05,
-  kChunk = 0x06,
-  kDataEnd = 0x0F
-};
 
 /// Fields of a record's content: little-endian integers, strings and byte arrays with a length prefix.
 class FieldReader {
@@ -186,7 +177,7 @@ class McapChannel {
     file_.read_exactly(file_record_.data(), length, "a record");
     record.content = file_record_;
     record.in_chunk = false;
-    if (record.opcode == kDataEnd || record.opcode == kFooter) {
+    if (record.opcode == detail::kMcapDataEnd || record.opcode == detail::kMcapFooter) {
       at_end_ = true;  // the summary after it repeats schemas and channels, and has no messages
       return false;
     }
@@ -198,7 +189,7 @@ class McapChannel {
     try {
       FieldReader fields(record.content);
       switch (record.opcode) {
-        case kSchema: {
+        case detail::kMcapSchema: {
           const auto id = fields.read<std::uint16_t>();
           Schema& schema = schemas_[id];
           schema.name = fields.read_string();
@@ -208,7 +199,7 @@ class McapChannel {
               schema.encoding == "ros1msg" || schema.encoding == "ros2msg" ? schema.data : std::string();
           return false;
         }
-        case kChannel: {
+        case detail::kMcapChannel: {
           const auto id = fields.read<std::uint16_t>();
           const auto schema = fields.read<std::uint16_t>();
           Channel channel;
@@ -225,12 +216,12 @@ class McapChannel {
           channels_[id] = std::move(channel);
           return false;
         }
-        case kMessage: {
+        case detail::kMcapMessage: {
           if (fields.read<std::uint16_t>() == channel_id_ && channel_id_ >= 0) return true;
           ++skipped_;
           return false;
         }
-        case kChunk:
+        case detail::kMcapChunk:
           if (record.in_chunk) throw std::runtime_error("a chunk inside a chunk");
           open_chunk(fields, record.offset);
           return false;

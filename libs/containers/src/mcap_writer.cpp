@@ -5,19 +5,10 @@
 #include <stdexcept>
 
 #include "evldt/containers/mcap.hpp"
+#include "mcap_records.hpp"
 
 namespace evldt {
 namespace {
-
-// Record types (MCAP specification).
-enum Opcode : std::uint8_t {
-  kHeader = 0x01,
-  kFooter = 0x02,
-  kSchema = 0x03,
-  kChannel = 0x04,
-  kMessage = 0x05,
-  kDataEnd = 0x0F
-};
 
 void put_le(std::string& out, std::uint64_t value, int bytes) {
   for (int i = 0; i < bytes; ++i) out += static_cast<char>(value >> (8 * i));
@@ -39,7 +30,7 @@ McapWriter::McapWriter(const std::filesystem::path& path, const std::string& pro
   std::string header;
   put_bytes(header, profile);
   put_bytes(header, "evldt");
-  record(kHeader, header);
+  record(detail::kMcapHeader, header);
 }
 
 McapWriter::~McapWriter() {
@@ -59,7 +50,7 @@ std::uint16_t McapWriter::add_schema(const std::string& name, const std::string&
   put_bytes(scratch_, name);
   put_bytes(scratch_, encoding);
   put_bytes(scratch_, data);
-  record(kSchema, scratch_);
+  record(detail::kMcapSchema, scratch_);
   return id;
 }
 
@@ -74,7 +65,7 @@ std::uint16_t McapWriter::add_channel(std::uint16_t schema, const std::string& t
   put_bytes(scratch_, topic);
   put_bytes(scratch_, message_encoding);
   put_le(scratch_, 0, 4);  // metadata: an empty map
-  record(kChannel, scratch_);
+  record(detail::kMcapChannel, scratch_);
   return id;
 }
 
@@ -86,7 +77,7 @@ void McapWriter::write(std::uint16_t channel, std::uint64_t time_ns, std::string
   put_le(scratch_, time_ns, 8);  // log time
   put_le(scratch_, time_ns, 8);  // publish time
   scratch_ += data;
-  record(kMessage, scratch_);
+  record(detail::kMcapMessage, scratch_);
   ++messages_;
 }
 
@@ -95,12 +86,12 @@ void McapWriter::close() {
   closed_ = true;
   std::string content;
   put_le(content, 0, 4);  // data section CRC: not computed
-  record(kDataEnd, content);
+  record(detail::kMcapDataEnd, content);
   content.clear();
   put_le(content, 0, 8);  // no summary section
   put_le(content, 0, 8);  // no summary offsets
   put_le(content, 0, 4);  // summary CRC: none
-  record(kFooter, content);
+  record(detail::kMcapFooter, content);
   out_.write(kMcapMagic.data(), static_cast<std::streamsize>(kMcapMagic.size()));
   out_.close();
   if (!out_) throw std::runtime_error("could not write '" + path_.string() + "' (disk full?)");
